@@ -1,0 +1,19 @@
+#pragma once
+// The traffic actor types and their meshes in assets/actors/ (frame: x forward, y left, z up, origin at
+// the footprint centre on the ground).
+#include <optional>
+#include <string>
+
+#include "sim/materials.hpp"
+#include "sim/triangle_mesh.hpp"
+
+namespace lidarloop {
+
+enum class ActorType { car, bus, truck, pedestrian, cyclist };
+
+std::optional<ActorType> actor_type_from_name(const std::string& name);
+std::string actor_type_name(ActorType type);
+std::string actor_type_names();  // "car, bus, truck, pedestrian, cyclist"
+TriangleMesh load_actor_mesh(const std::string& actors_dir, ActorType type, const MaterialTable& materials);
+
+}  // namespace lidarloop

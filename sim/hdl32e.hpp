@@ -1,0 +1,67 @@
+#pragma once
+// Velodyne HDL-32E: beam geometry, firing timing and return model parameters, with the datasheet's
+// values as defaults. All of it can be overridden from YAML (`lidar:` in a scenario).
+#include <array>
+#include <cstdint>
+
+#include <Eigen/Geometry>
+
+#include "common/yaml_reader.hpp"
+
+namespace lidarloop {
+
+constexpr int kHdl32eLasers = 32;
+
+struct Hdl32eConfig {
+  // Elevation of each laser by ring (0 = lowest): -30.67 deg to +10.67 deg in 4/3 deg steps.
+  std::array<double, kHdl32eLasers> elevation_deg = default_elevations();
+  // The ring fired in each of the 32 firing slots of a cycle: the lower and upper banks alternate,
+  // -30.67, -9.33, -29.33, -8.00, ..., -10.67, +10.67.
+  std::array<int, kHdl32eLasers> firing_order = default_firing_order();
+  int64_t firing_period_ns = 1152;  // one laser every 1.152 us
+  int slots_per_cycle = 40;         // 32 firings + 8 idle slots = 46.08 us per cycle
+  double rotation_hz = 10.0;        // 5-20 Hz
+  double scan_start_yaw_deg = 180;  // where a scan begins (and the previous one ends): behind the car
+
+  double min_range_m = 1.0;
+  double max_range_m = 100.0;
+  double range_resolution_m = 0.002;  // 2 mm quantisation
+  double range_noise_m = 0.02;        // 1 sigma
+
+  // Detection: received power ~ reflectivity * cos(incidence)^detection_incidence_exponent / range^2;
+  // a target of dark_target_reflectivity at dark_target_range_m is detected half the time.
+  double dark_target_reflectivity = 0.10;
+  double dark_target_range_m = 70.0;
+  double detection_incidence_exponent = 0.5;
+  double detection_softness = 0.15;   // width of the detection ramp in log power
+  double max_incidence_deg = 87.0;    // grazing returns beyond this are lost
+  // Intensity: 100 * reflectivity * cos(incidence)^intensity_incidence_exponent * laser gain
+  //            * min(1, intensity_reference_range_m / range)^intensity_range_exponent + noise.
+  double intensity_incidence_exponent = 0.5;
+  double intensity_reference_range_m = 10.0;
+  double intensity_range_exponent = 0.25;
+  double intensity_noise = 1.5;       // counts, 1 sigma
+  double laser_gain_spread = 0.08;    // per-laser gains uniform in 1 +- spread, fixed by the unit's serial
+  uint64_t unit_serial = 1;
+
+  // Sensor pose in the vehicle frame (origin at the rear axle centre on the ground).
+  Eigen::Vector3d mount_xyz{1.2, 0.0, 1.9};
+  Eigen::Vector3d mount_rpy_deg{0.0, 0.0, 0.0};
+  bool motion_distortion = true;      // cast each firing from the pose at its own time
+  int cycles_per_actor_update = 16;   // actors move every 16 firing cycles (0.74 ms)
+
+  int64_t cycle_period_ns() const { return firing_period_ns * slots_per_cycle; }
+  int64_t scan_period_ns() const { return static_cast<int64_t>(1e9 / rotation_hz + 0.5); }
+  // Full firing cycles in one revolution: 2170 at 10 Hz.
+  int cycles_per_scan() const { return static_cast<int>(scan_period_ns() / cycle_period_ns()); }
+  int64_t firing_time_ns(int cycle, int slot) const { return cycle * cycle_period_ns() + slot * firing_period_ns; }
+  Eigen::Isometry3d mount() const;
+
+  static std::array<double, kHdl32eLasers> default_elevations();
+  static std::array<int, kHdl32eLasers> default_firing_order();
+};
+
+// Applies the overrides in a YAML mapping (keys as the field names) and validates the result.
+void read_hdl32e_config(const YamlReader& yaml, const YAML::Node& node, Hdl32eConfig& config);
+
+}  // namespace lidarloop

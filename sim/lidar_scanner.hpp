@@ -1,0 +1,67 @@
+#pragma once
+// Casts HDL-32E scans into a RayScene.
+//
+// Motion distortion: every firing cycle is cast from the sensor pose at its own time, so a scan taken
+// while driving or turning is skewed like a real one; within a cycle (36.9 us of firings) the origin
+// moves on linearly. Points are reported in the sensor frame of their own firing instant, as a
+// Velodyne driver reports them. Actors are moved every `cycles_per_actor_update` cycles.
+//
+// Output order is firing order, and each ray's noise comes from a counter-based generator keyed by the
+// scan and the ray's index, so the cloud is identical whatever the number of threads.
+#include <functional>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "common/point_cloud.hpp"
+#include "sim/hdl32e.hpp"
+#include "sim/lidar_return.hpp"
+#include "sim/materials.hpp"
+#include "sim/ray_scene.hpp"
+
+namespace lidarloop {
+
+// Vehicle pose in the world at a time (ns since scenario start).
+using PoseAt = std::function<Eigen::Isometry3d(int64_t t_ns)>;
+// Moves the scene's actors to where they are at a time; the scanner commits the scene afterwards.
+using ActorMover = std::function<void(int64_t t_ns, RayScene& scene)>;
+
+// A vehicle moving at constant speed and yaw rate on flat ground (a circular arc), from `start` at t0.
+PoseAt constant_twist(const Eigen::Isometry3d& start, int64_t t0_ns, double speed_mps, double yaw_rate_radps);
+
+struct LidarRay {
+  Eigen::Vector3f origin, direction;  // world frame, unit direction
+};
+
+class LidarScanner {
+ public:
+  LidarScanner(const Hdl32eConfig& config, const MaterialTable& materials);
+
+  const Hdl32eConfig& config() const { return config_; }
+
+  PointCloud scan(RayScene& scene, const PoseAt& vehicle_pose, int64_t stamp_ns, uint64_t seed,
+                  const ActorMover& move_actors = {}) const;
+
+  // The rays of one scan in firing order (cycle-major, then firing slot); scan() casts exactly these.
+  std::vector<LidarRay> rays(const PoseAt& vehicle_pose, int64_t stamp_ns) const;
+  int rays_per_scan() const { return config_.cycles_per_scan() * kHdl32eLasers; }
+
+ private:
+  struct CyclePose {
+    Eigen::Matrix3f rotation;
+    Eigen::Vector3f origin, velocity;  // velocity carries the origin through the cycle
+  };
+  std::vector<CyclePose> cycle_poses(const PoseAt& vehicle_pose, int64_t stamp_ns) const;
+  Eigen::Vector3f sensor_direction(int cycle, int slot) const;
+  LidarRay ray(const CyclePose& pose, int cycle, int slot) const;
+
+  Hdl32eConfig config_;
+  std::vector<Material> materials_;
+  ReturnModel returns_;
+  Eigen::Isometry3d mount_;
+  // Per firing slot: the beam's unit vector at zero yaw, with the slot's own yaw advance folded in.
+  std::array<Eigen::Vector3f, kHdl32eLasers> slot_direction_;
+  std::vector<Eigen::Vector2f> cycle_yaw_;  // (cos, sin) of each cycle's starting yaw
+};
+
+}  // namespace lidarloop

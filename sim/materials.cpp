@@ -1,0 +1,45 @@
+#include "sim/materials.hpp"
+
+#include <limits>
+
+#include "common/yaml_reader.hpp"
+
+namespace lidarloop {
+
+MaterialTable MaterialTable::load(const std::string& path) {
+  const YamlReader yaml = YamlReader::open(path);
+  yaml.expect_map(yaml.root(), "the materials file");
+  yaml.allow_keys(yaml.root(), {"materials"});
+  const YAML::Node list = yaml.required(yaml.root(), "materials");
+  yaml.expect_map(list, "materials");
+  MaterialTable table;
+  table.file_ = path;
+  for (const auto& entry : list) {
+    yaml.expect_map(entry.second, "material '" + entry.first.Scalar() + "'");
+    yaml.allow_keys(entry.second, {"reflectivity", "retro", "description"});
+    Material m;
+    m.name = entry.first.Scalar();
+    m.reflectivity = yaml.number_in(yaml.required(entry.second, "reflectivity"), "reflectivity", 0.0, 1.0);
+    if (entry.second["retro"]) m.retro = yaml.boolean(entry.second["retro"], "retro");
+    if (table.contains(m.name)) yaml.fail(entry.first, "material '" + m.name + "' is defined twice");
+    table.materials_.push_back(m);
+  }
+  if (table.materials_.empty()) throw InputError(path + ": no materials defined");
+  if (table.materials_.size() > std::numeric_limits<MaterialId>::max())
+    throw InputError(path + ": too many materials");
+  return table;
+}
+
+bool MaterialTable::contains(const std::string& name) const {
+  for (const auto& m : materials_)
+    if (m.name == name) return true;
+  return false;
+}
+
+MaterialId MaterialTable::id(const std::string& name, const std::string& context) const {
+  for (size_t i = 0; i < materials_.size(); ++i)
+    if (materials_[i].name == name) return static_cast<MaterialId>(i);
+  throw InputError(context + ": unknown material '" + name + "' (not in " + file_ + ")");
+}
+
+}  // namespace lidarloop

@@ -1,0 +1,35 @@
+#pragma once
+// 2-D polyline geometry for road centrelines and markings.
+#include <optional>
+
+#include <Eigen/Geometry>
+
+#include "common/curb_map_file.hpp"  // Polyline2d
+
+namespace lidarloop {
+
+double polyline_length(const Polyline2d& line);
+
+struct PolylineSample {
+  Eigen::Vector2d point;
+  Eigen::Vector2d tangent;  // unit
+};
+// Point and direction at arc length s (clamped to the line).
+PolylineSample sample_polyline(const Polyline2d& line, double s);
+
+// Arc length of the point of the line nearest to p.
+double project_onto_polyline(const Polyline2d& line, const Eigen::Vector2d& p);
+
+// Rounds every interior corner (and the closing corner of a closed line) with a circular arc of
+// `radius`, shrunk where the adjacent segments are too short; arcs are split every `max_step_rad`.
+Polyline2d fillet_polyline(const Polyline2d& line, double radius, bool closed, double max_step_rad);
+
+// The line shifted sideways by `offset` (positive = left of the direction of travel), mitred joins.
+Polyline2d offset_polyline(const Polyline2d& line, double offset, bool closed);
+
+bool segments_intersect(const Eigen::Vector2d& a0, const Eigen::Vector2d& a1, const Eigen::Vector2d& b0,
+                        const Eigen::Vector2d& b1);
+// Indices (i, j) of the first two non-adjacent segments that cross, if any.
+std::optional<std::pair<size_t, size_t>> find_self_intersection(const Polyline2d& line, bool closed);
+
+}  // namespace lidarloop

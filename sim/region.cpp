@@ -1,0 +1,224 @@
+#include "sim/region.hpp"
+
+#include <cmath>
+
+namespace lidarloop::region {
+
+using ClipperLib::cInt;
+using ClipperLib::IntPoint;
+using ClipperLib::Path;
+
+namespace {
+
+constexpr double kArcTolerance = 0.005 * kScale;  // round joins deviate at most 5 mm from a true arc
+
+IntPoint to_int(const Eigen::Vector2d& p) {
+  return {static_cast<cInt>(std::llround(p.x() * kScale)), static_cast<cInt>(std::llround(p.y() * kScale))};
+}
+Eigen::Vector2d to_metres(const IntPoint& p) { return {double(p.X) / kScale, double(p.Y) / kScale}; }
+
+Paths boolean(const Paths& a, const Paths& b, ClipperLib::ClipType type) {
+  ClipperLib::Clipper c;
+  c.AddPaths(a, ClipperLib::ptSubject, true);
+  c.AddPaths(b, ClipperLib::ptClip, true);
+  Paths out;
+  c.Execute(type, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  return out;
+}
+
+int64_t cross(const IntPoint& a, const IntPoint& b, const IntPoint& c) {
+  return (b.X - a.X) * (c.Y - a.Y) - (b.Y - a.Y) * (c.X - a.X);
+}
+
+Paths square(cInt x0, cInt y0, cInt size) {
+  return {{{x0, y0}, {x0 + size, y0}, {x0 + size, y0 + size}, {x0, y0 + size}}};
+}
+
+struct Mesher {
+  const std::function<float(const Eigen::Vector2d&)>& height;
+  MaterialId material;
+  TriangleMesh& mesh;
+  cInt leaf_size, min_size;
+
+  void emit(const Path& polygon) {
+    const auto base = static_cast<uint32_t>(mesh.vertices.size());
+    for (const auto& p : polygon) {
+      const Eigen::Vector2d xy = to_metres(p);
+      mesh.vertices.emplace_back(float(xy.x()), float(xy.y()), height(xy));
+    }
+    for (const auto& t : triangulate_polygon(polygon))
+      mesh.add_triangle(base + t[0], base + t[1], base + t[2], material);
+  }
+
+  void node(const Paths& parent, cInt x0, cInt y0, cInt size) {
+    const Paths piece = intersect(parent, square(x0, y0, size));
+    if (piece.empty()) return;
+    double covered = 0;
+    bool has_hole = false;
+    for (const auto& p : piece) {
+      covered += ClipperLib::Area(p);
+      has_hole = has_hole || !ClipperLib::Orientation(p);
+    }
+    if (covered >= double(size) * double(size) * (1 - 1e-9)) {
+      emit(square(x0, y0, size)[0]);
+      return;
+    }
+    if (size > leaf_size || (has_hole && size > min_size)) {
+      const cInt h = size / 2;
+      for (int k = 0; k < 4; ++k) node(piece, x0 + (k & 1) * h, y0 + (k >> 1) * h, h);
+      return;
+    }
+    for (auto p : piece) {
+      if (!ClipperLib::Orientation(p)) continue;  // a hole smaller than min_size: not worth meshing
+      ClipperLib::CleanPolygon(p, 2.0);
+      if (p.size() >= 3) emit(p);
+    }
+  }
+};
+
+}  // namespace
+
+Path to_path(const Polyline2d& line) {
+  Path path;
+  for (const auto& p : line) path.push_back(to_int(p));
+  return path;
+}
+
+Polyline2d to_polyline(const Path& path, bool repeat_first) {
+  Polyline2d line;
+  for (const auto& p : path) line.push_back(to_metres(p));
+  if (repeat_first && !path.empty()) line.push_back(to_metres(path.front()));
+  return line;
+}
+
+Paths strip(const Polyline2d& centreline, double half_width, bool closed_line) {
+  ClipperLib::ClipperOffset off(2.0, kArcTolerance);
+  Path path = to_path(centreline);
+  if (closed_line && path.size() > 1 && path.front() == path.back()) path.pop_back();
+  off.AddPath(path, ClipperLib::jtRound, closed_line ? ClipperLib::etClosedLine : ClipperLib::etOpenButt);
+  Paths out;
+  off.Execute(out, half_width * kScale);
+  return out;
+}
+
+Paths rectangle(const Eigen::Vector2d& centre, const Eigen::Vector2d& axis, double half_length, double half_width) {
+  const Eigen::Vector2d u = axis.normalized(), v(-u.y(), u.x());
+  return {{to_int(centre - u * half_length - v * half_width), to_int(centre + u * half_length - v * half_width),
+           to_int(centre + u * half_length + v * half_width), to_int(centre - u * half_length + v * half_width)}};
+}
+
+Paths offset(const Paths& region, double delta) {
+  ClipperLib::ClipperOffset off(2.0, kArcTolerance);
+  off.AddPaths(region, ClipperLib::jtRound, ClipperLib::etClosedPolygon);
+  Paths out;
+  off.Execute(out, delta * kScale);
+  return out;
+}
+
+Paths unite(const Paths& a, const Paths& b) { return boolean(a, b, ClipperLib::ctUnion); }
+Paths subtract(const Paths& a, const Paths& b) { return boolean(a, b, ClipperLib::ctDifference); }
+Paths intersect(const Paths& a, const Paths& b) { return boolean(a, b, ClipperLib::ctIntersection); }
+
+Paths closing(const Paths& region, double radius) {
+  if (radius <= 0) return unite(region, {});
+  return offset(offset(region, radius), -radius);
+}
+
+std::vector<Polyline2d> clip_lines_outside(const std::vector<Polyline2d>& lines, const Paths& region) {
+  ClipperLib::Clipper c;
+  for (const auto& line : lines) c.AddPath(to_path(line), ClipperLib::ptSubject, false);
+  c.AddPaths(region, ClipperLib::ptClip, true);
+  ClipperLib::PolyTree tree;
+  c.Execute(ClipperLib::ctDifference, tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  Paths open;
+  ClipperLib::OpenPathsFromPolyTree(tree, open);
+  std::vector<Polyline2d> out;
+  for (const auto& p : open) out.push_back(to_polyline(p, false));
+  return out;
+}
+
+bool contains(const Paths& region, const Eigen::Vector2d& p) {
+  const IntPoint q = to_int(p);
+  int winding = 0;
+  for (const auto& path : region)
+    if (ClipperLib::PointInPolygon(q, path) != 0) winding += ClipperLib::Orientation(path) ? 1 : -1;
+  return winding > 0;
+}
+
+double area(const Paths& region) {
+  double a = 0;
+  for (const auto& p : region) a += ClipperLib::Area(p);
+  return a / (kScale * kScale);
+}
+
+void mesh_region(const Paths& region, double tile_size, const std::function<float(const Eigen::Vector2d&)>& height,
+                 MaterialId material, TriangleMesh& mesh) {
+  if (region.empty()) return;
+  const auto leaf = static_cast<cInt>(std::llround(tile_size * kScale));
+  cInt min_x = INT64_MAX, min_y = INT64_MAX, max_x = INT64_MIN, max_y = INT64_MIN;
+  for (const auto& path : region)
+    for (const auto& p : path) {
+      min_x = std::min(min_x, p.X), min_y = std::min(min_y, p.Y);
+      max_x = std::max(max_x, p.X), max_y = std::max(max_y, p.Y);
+    }
+  // Root square: a power-of-two multiple of the tile, on the global tile grid, covering the region.
+  auto floor_to = [](cInt v, cInt step) { return (v >= 0 ? v / step : (v - step + 1) / step) * step; };
+  const cInt x0 = floor_to(min_x, leaf), y0 = floor_to(min_y, leaf);
+  cInt size = leaf;
+  while (x0 + size < max_x || y0 + size < max_y) size *= 2;
+  Mesher mesher{height, material, mesh, leaf, std::max<cInt>(leaf / 16, 1)};
+  mesher.node(region, x0, y0, size);
+}
+
+std::vector<std::array<uint32_t, 3>> triangulate_polygon(const Path& polygon) {
+  std::vector<std::array<uint32_t, 3>> out;
+  std::vector<uint32_t> idx(polygon.size());
+  for (uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+  if (!ClipperLib::Orientation(polygon)) std::reverse(idx.begin(), idx.end());
+
+  auto inside = [&](const IntPoint& p, const IntPoint& a, const IntPoint& b, const IntPoint& c) {
+    return cross(a, b, p) >= 0 && cross(b, c, p) >= 0 && cross(c, a, p) >= 0;
+  };
+  while (idx.size() > 3) {
+    const size_t m = idx.size();
+    bool clipped = false;
+    for (size_t i = 0; i < m && !clipped; ++i) {
+      const uint32_t ia = idx[(i + m - 1) % m], ib = idx[i], ic = idx[(i + 1) % m];
+      const IntPoint &a = polygon[ia], &b = polygon[ib], &c = polygon[ic];
+      const int64_t turn = cross(a, b, c);
+      if (turn == 0) {  // collinear vertex: drop it, no triangle
+        idx.erase(idx.begin() + long(i));
+        clipped = true;
+        break;
+      }
+      if (turn < 0) continue;  // reflex
+      bool ear = true;
+      for (size_t j = 0; j < m && ear; ++j) {
+        const IntPoint& p = polygon[idx[j]];
+        if (idx[j] == ia || idx[j] == ib || idx[j] == ic || p == a || p == b || p == c) continue;
+        ear = !inside(p, a, b, c);
+      }
+      if (!ear) continue;
+      out.push_back({ia, ib, ic});
+      idx.erase(idx.begin() + long(i));
+      clipped = true;
+    }
+    if (!clipped) {
+      // Only possible for numerically degenerate input: take the first convex corner regardless.
+      for (size_t i = 0; i < m && !clipped; ++i) {
+        const uint32_t ia = idx[(i + m - 1) % m], ib = idx[i], ic = idx[(i + 1) % m];
+        if (cross(polygon[ia], polygon[ib], polygon[ic]) > 0) {
+          out.push_back({ia, ib, ic});
+          idx.erase(idx.begin() + long(i));
+          clipped = true;
+        }
+      }
+      if (!clipped) return out;
+    }
+  }
+  if (idx.size() == 3 && cross(polygon[idx[0]], polygon[idx[1]], polygon[idx[2]]) > 0)
+    out.push_back({idx[0], idx[1], idx[2]});
+  return out;
+}
+
+}  // namespace lidarloop::region

@@ -1,0 +1,45 @@
+#pragma once
+// Planar regions (polygons with holes) for the world generator, on top of Clipper's exact integer
+// arithmetic: offsets, boolean operations, morphological closing, and meshing into triangles.
+#include <functional>
+
+#include <polyclipping/clipper.hpp>
+
+#include "common/curb_map_file.hpp"  // Polyline2d
+#include "sim/triangle_mesh.hpp"
+
+namespace lidarloop::region {
+
+using Paths = ClipperLib::Paths;
+
+// Clipper works on integers: 1 unit = 0.1 mm, far below anything a LiDAR resolves.
+constexpr double kScale = 1e4;
+
+ClipperLib::Path to_path(const Polyline2d& line);
+Polyline2d to_polyline(const ClipperLib::Path& path, bool repeat_first);
+
+// The area within half_width of a centreline (butt ends; a closed line gives a ring).
+Paths strip(const Polyline2d& centreline, double half_width, bool closed_line);
+Paths rectangle(const Eigen::Vector2d& centre, const Eigen::Vector2d& axis, double half_length, double half_width);
+Paths offset(const Paths& region, double delta);  // grow (delta > 0) or shrink, round joins
+Paths unite(const Paths& a, const Paths& b);
+Paths subtract(const Paths& a, const Paths& b);
+Paths intersect(const Paths& a, const Paths& b);
+// Morphological closing: fills concave corners tighter than `radius` with circular arcs.
+Paths closing(const Paths& region, double radius);
+// Parts of open polylines outside `region`.
+std::vector<Polyline2d> clip_lines_outside(const std::vector<Polyline2d>& lines, const Paths& region);
+
+bool contains(const Paths& region, const Eigen::Vector2d& p);
+double area(const Paths& region);
+
+// Triangulates a region as a horizontal surface whose height is given per vertex. The region is cut
+// into square tiles aligned to a global grid (so neighbouring regions share tile edges), keeping
+// triangles small and every piece a simple polygon.
+void mesh_region(const Paths& region, double tile_size, const std::function<float(const Eigen::Vector2d&)>& height,
+                 MaterialId material, TriangleMesh& mesh);
+
+// Ear-clipping triangulation of a simple polygon; returns index triples into `polygon`.
+std::vector<std::array<uint32_t, 3>> triangulate_polygon(const ClipperLib::Path& polygon);
+
+}  // namespace lidarloop::region

@@ -1,0 +1,47 @@
+// lidarloop world: build a world and export its mesh and curb map.
+#include <chrono>
+#include <iostream>
+
+#include "sim/obj_file.hpp"
+#include "tools/commands.hpp"
+#include "tools/world_assets.hpp"
+
+namespace lidarloop {
+
+static int run_world(const Args& args) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const LoadedWorld w = load_world(args.positional().at(0));
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  double curb_length = 0;
+  for (const auto& c : w.world.curbs)
+    for (size_t i = 1; i < c.size(); ++i) curb_length += (c[i] - c[i - 1]).norm();
+  const auto size = w.world.bounds.sizes();
+  std::cout << "world        " << w.world.name << " (" << w.description.file << ")\n"
+            << "origin       " << w.world.origin.lat_deg << ", " << w.world.origin.lon_deg << " (WGS-84)\n"
+            << "extent       " << size.x() << " m x " << size.y() << " m\n"
+            << "roads        " << w.description.roads.size() << "\n"
+            << "curb lines   " << w.world.curbs.size() << " (" << curb_length << " m)\n"
+            << "triangles    " << w.world.mesh.triangle_count() << "\n"
+            << "built in     " << ms << " ms\n";
+  if (auto obj = args.value("obj")) {
+    write_obj(*obj, w.world.mesh, w.materials);
+    std::cout << "mesh         " << *obj << "\n";
+  }
+  if (auto curbs = args.value("curbs")) {
+    write_curb_map(*curbs, w.world.curb_map());
+    std::cout << "curb map     " << *curbs << "\n";
+  }
+  return 0;
+}
+
+Command world_command() {
+  return {{"world",
+           "lidarloop world WORLD [--obj FILE.obj] [--curbs FILE.geojson]",
+           "Build a world (a name under maps/ or a world.yaml path); print its size, export mesh and curbs.",
+           {{"obj", "FILE", "write the triangle mesh as Wavefront OBJ (one usemtl group per material)"},
+            {"curbs", "FILE", "write the curb map as GeoJSON LineStrings in WGS-84"}},
+           1, 1},
+          run_world};
+}
+
+}  // namespace lidarloop

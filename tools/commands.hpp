@@ -1,0 +1,21 @@
+#pragma once
+#include <string>
+#include <vector>
+
+#include "tools/cli_args.hpp"
+
+namespace lidarloop {
+
+struct Command {
+  CommandSpec spec;
+  int (*run)(const Args& args);
+};
+
+Command world_command();
+Command scan_command();
+Command bench_command();
+
+// --threads N: 0 means all cores. Returns the effective count.
+int thread_count(const Args& args);
+
+}  // namespace lidarloop

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs the Debian packages lidarloop needs, skipping those already present.
+# Idempotent; works as root or through sudo. Used by both quick-start commands.
+set -euo pipefail
+
+packages=(
+  cmake g++ ninja-build ccache pkg-config
+  libembree-dev libeigen3-dev libgeographiclib-dev libnanoflann-dev libyaml-cpp-dev
+  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libpolyclipping-dev nlohmann-json3-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+if [ "$(id -u)" -eq 0 ]; then sudo_cmd=(); else sudo_cmd=(sudo); fi
+echo "install_deps: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

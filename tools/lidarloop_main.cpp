@@ -1,0 +1,51 @@
+// lidarloop: the command-line front end. Exit codes: 0 success, 1 a scenario failed its thresholds,
+// 2 bad input or usage.
+#include <iostream>
+
+#include "common/input_error.hpp"
+#include "tools/commands.hpp"
+
+using namespace lidarloop;
+
+static std::vector<Command> commands() { return {world_command(), scan_command(), bench_command()}; }
+
+static void print_usage(std::ostream& out) {
+  out << "usage: lidarloop <command> [options]   (lidarloop <command> --help for details)\n\ncommands:\n";
+  for (const auto& c : commands()) {
+    std::string name = "  " + c.spec.name;
+    name.resize(12, ' ');
+    out << name << c.spec.summary.substr(0, c.spec.summary.find('\n')) << "\n";
+  }
+}
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    print_usage(std::cerr);
+    return 2;
+  }
+  const std::string name = argv[1];
+  if (name == "--help" || name == "-h" || name == "help") {
+    print_usage(std::cout);
+    return 0;
+  }
+  for (const auto& c : commands()) {
+    if (c.spec.name != name) continue;
+    try {
+      const Args args = parse_args(c.spec, std::vector<std::string>(argv + 2, argv + argc));
+      if (args.flag("help")) {
+        std::cout << help(c.spec);
+        return 0;
+      }
+      return c.run(args);
+    } catch (const InputError& e) {
+      std::cerr << "lidarloop: error: " << e.what() << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << "lidarloop: internal error: " << e.what() << "\n";
+      return 3;
+    }
+  }
+  std::cerr << "lidarloop: error: unknown command '" << name << "'\n";
+  print_usage(std::cerr);
+  return 2;
+}

@@ -1,0 +1,30 @@
+#pragma once
+// Finding and building the worlds and assets the CLI works with.
+#include <string>
+
+#include "sim/materials.hpp"
+#include "sim/world_builder.hpp"
+
+namespace lidarloop {
+
+// The project's data folder (maps/, assets/): $LIDARLOOP_DATA, else the source tree it was built from.
+std::string data_dir();
+std::string actors_dir();
+// A world given by name (maps/<name>/world.yaml) or by a path to its YAML file.
+std::string world_file(const std::string& name_or_path);
+
+struct LoadedWorld {
+  MaterialTable materials;
+  WorldDescription description;
+  World world;
+};
+LoadedWorld load_world(const std::string& name_or_path);
+
+}  // namespace lidarloop
+
+namespace lidarloop {
+// A sensible place to put a car: `s` metres along the first road, in the right-hand lane, heading along it.
+Eigen::Isometry3d default_start_pose(const WorldDescription& description, double s = 20.0);
+// Vehicle pose from x, y (m) and yaw (rad) on the ground plane.
+Eigen::Isometry3d planar_pose(double x, double y, double yaw);
+}  // namespace lidarloop
