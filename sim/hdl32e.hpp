@@ -48,7 +48,9 @@ struct Hdl32eConfig {
   Eigen::Vector3d mount_xyz{1.2, 0.0, 1.9};
   Eigen::Vector3d mount_rpy_deg{0.0, 0.0, 0.0};
   bool motion_distortion = true;      // cast each firing from the pose at its own time
-  int cycles_per_actor_update = 16;   // actors move every 16 firing cycles (0.74 ms)
+  // Actor poses are keyframed every this many firing cycles (1.47 ms) and interpolated linearly in
+  // between; raised automatically if a scan would need more keyframes than Embree allows.
+  int cycles_per_actor_update = 32;
 
   int64_t cycle_period_ns() const { return firing_period_ns * slots_per_cycle; }
   int64_t scan_period_ns() const { return static_cast<int64_t>(1e9 / rotation_hz + 0.5); }

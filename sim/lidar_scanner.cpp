@@ -34,7 +34,12 @@ LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& mate
     slot_direction_[slot] = Eigen::Vector3f(float(std::cos(elevation) * std::cos(yaw)),
                                             float(std::cos(elevation) * std::sin(yaw)), float(std::sin(elevation)));
   }
-  for (int cycle = 0; cycle < config.cycles_per_scan(); ++cycle) {
+  const int cycles = config.cycles_per_scan();
+  const int per_keyframe = std::max(config.cycles_per_actor_update,
+                                    (cycles + RayScene::kMaxKeyframes - 2) / (RayScene::kMaxKeyframes - 1));
+  keyframes_ = (cycles + per_keyframe - 1) / per_keyframe + 1;
+  keyframe_step_ns_ = per_keyframe * config.cycle_period_ns();
+  for (int cycle = 0; cycle < cycles; ++cycle) {
     const double yaw = config.scan_start_yaw_deg * kDeg + yaw_rate * double(config.firing_time_ns(cycle, 0)) * 1e-9;
     cycle_yaw_.emplace_back(float(std::cos(yaw)), float(std::sin(yaw)));
   }
@@ -68,7 +73,8 @@ Eigen::Vector3f LidarScanner::sensor_direction(int cycle, int slot) const {
 
 LidarRay LidarScanner::ray(const CyclePose& pose, int cycle, int slot) const {
   const float dt = float(double(slot * config_.firing_period_ns) * 1e-9);
-  return {pose.origin + pose.velocity * dt, pose.rotation * sensor_direction(cycle, slot)};
+  const double time = double(config_.firing_time_ns(cycle, slot)) / double((keyframes_ - 1) * keyframe_step_ns_);
+  return {pose.origin + pose.velocity * dt, pose.rotation * sensor_direction(cycle, slot), float(time)};
 }
 
 std::vector<LidarRay> LidarScanner::rays(const PoseAt& vehicle_pose, int64_t stamp_ns) const {
@@ -81,7 +87,7 @@ std::vector<LidarRay> LidarScanner::rays(const PoseAt& vehicle_pose, int64_t sta
 }
 
 PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64_t stamp_ns, uint64_t seed,
-                              const ActorMover& move_actors) const {
+                              const ActorPoses& actor_poses) const {
   const auto poses = cycle_poses(vehicle_pose, stamp_ns);
   const int cycles = int(poses.size());
   const CounterRng rng(seed, uint64_t(stamp_ns));
@@ -89,38 +95,48 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
   std::vector<uint8_t> valid(points.size(), 0);
   const float tnear = float(config_.min_range_m) * 0.5f, tfar = float(config_.max_range_m) * 1.05f;
 
+  // Rays travel in packets of the same laser over consecutive cycles: nearly parallel, so Embree's
+  // packet traversal visits almost the same nodes for all of them.
+  constexpr int kPacket = RayScene::kPacket;
   auto cast = [&](int first_cycle, int end_cycle) {
-    const size_t begin = size_t(first_cycle) * kHdl32eLasers, end = size_t(end_cycle) * kHdl32eLasers;
-    tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 256), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        const int cycle = int(i / kHdl32eLasers), slot = int(i % kHdl32eLasers);
-        const LidarRay r = ray(poses[cycle], cycle, slot);
-        RayHit hit;
-        if (!scene.intersect(r.origin, r.direction, tnear, tfar, hit)) continue;
+    const int groups = (end_cycle - first_cycle + kPacket - 1) / kPacket;
+    tbb::parallel_for(tbb::blocked_range<int>(0, groups * kHdl32eLasers, 8), [&](const tbb::blocked_range<int>& range) {
+      LidarRay rays[kPacket];
+      RayHit hits[kPacket];
+      bool found[kPacket];
+      for (int packet = range.begin(); packet != range.end(); ++packet) {
+        const int slot = packet % kHdl32eLasers, cycle0 = first_cycle + (packet / kHdl32eLasers) * kPacket;
+        const int count = std::min(kPacket, end_cycle - cycle0);
+        for (int k = 0; k < count; ++k) rays[k] = ray(poses[cycle0 + k], cycle0 + k, slot);
+        scene.intersect8(rays, count, tnear, tfar, hits, found);
         const int ring = config_.firing_order[slot];
-        const double cos_incidence = std::abs(double(hit.normal.dot(r.direction)));
-        const auto ret = returns_(materials_[hit.material], hit.range, cos_incidence, ring, rng, i);
-        if (!ret) continue;
-        const Eigen::Vector3f p = sensor_direction(cycle, slot) * ret->range;
-        points[i] = {p.x(), p.y(), p.z(), ret->intensity, uint16_t(ring),
-                     uint32_t(config_.firing_time_ns(cycle, slot))};
-        valid[i] = 1;
+        for (int k = 0; k < count; ++k) {
+          if (!found[k]) continue;
+          const int cycle = cycle0 + k;
+          const size_t i = size_t(cycle) * kHdl32eLasers + size_t(slot);
+          const double cos_incidence = std::abs(double(hits[k].normal.dot(rays[k].direction)));
+          const auto ret = returns_(materials_[hits[k].material], hits[k].range, cos_incidence, ring, rng, i);
+          if (!ret) continue;
+          const Eigen::Vector3f p = sensor_direction(cycle, slot) * ret->range;
+          points[i] = {p.x(), p.y(), p.z(), ret->intensity, uint16_t(ring),
+                       uint32_t(config_.firing_time_ns(cycle, slot))};
+          valid[i] = 1;
+        }
       }
     });
   };
 
-  if (move_actors && scene.actor_count() > 0) {
-    const int block = config_.cycles_per_actor_update;
-    for (int c = 0; c < cycles; c += block) {
-      const int end = std::min(cycles, c + block);
-      // Actors stand where they are at the middle of the block.
-      move_actors(stamp_ns + (config_.firing_time_ns(c, 0) + config_.firing_time_ns(end, 0)) / 2, scene);
-      scene.commit();
-      cast(c, end);
+  if (actor_poses && scene.actor_count() > 0) {
+    std::vector<std::vector<Eigen::Isometry3d>> motion(scene.actor_count());
+    std::vector<Eigen::Isometry3d> poses(scene.actor_count());
+    for (int k = 0; k < keyframes_; ++k) {
+      actor_poses(stamp_ns + k * keyframe_step_ns_, poses);
+      for (size_t a = 0; a < poses.size(); ++a) motion[a].push_back(poses[a]);
     }
-  } else {
-    cast(0, cycles);
+    for (size_t a = 0; a < motion.size(); ++a) scene.set_actor_motion(int(a), motion[a]);
+    scene.commit();
   }
+  cast(0, cycles);
 
   PointCloud cloud;
   cloud.stamp_ns = stamp_ns;

@@ -4,7 +4,8 @@
 // Motion distortion: every firing cycle is cast from the sensor pose at its own time, so a scan taken
 // while driving or turning is skewed like a real one; within a cycle (36.9 us of firings) the origin
 // moves on linearly. Points are reported in the sensor frame of their own firing instant, as a
-// Velodyne driver reports them. Actors are moved every `cycles_per_actor_update` cycles.
+// Velodyne driver reports them. Actors move during the scan too: their poses are keyframed every
+// `cycles_per_actor_update` cycles and each ray meets them where they are at its own time.
 //
 // Output order is firing order, and each ray's noise comes from a counter-based generator keyed by the
 // scan and the ray's index, so the cloud is identical whatever the number of threads.
@@ -23,15 +24,13 @@ namespace lidarloop {
 
 // Vehicle pose in the world at a time (ns since scenario start).
 using PoseAt = std::function<Eigen::Isometry3d(int64_t t_ns)>;
-// Moves the scene's actors to where they are at a time; the scanner commits the scene afterwards.
-using ActorMover = std::function<void(int64_t t_ns, RayScene& scene)>;
+// Where the scene's actors are at a time: fills one pose per actor, in the scene's actor order.
+using ActorPoses = std::function<void(int64_t t_ns, std::vector<Eigen::Isometry3d>& poses)>;
 
 // A vehicle moving at constant speed and yaw rate on flat ground (a circular arc), from `start` at t0.
 PoseAt constant_twist(const Eigen::Isometry3d& start, int64_t t0_ns, double speed_mps, double yaw_rate_radps);
 
-struct LidarRay {
-  Eigen::Vector3f origin, direction;  // world frame, unit direction
-};
+using LidarRay = Ray;
 
 class LidarScanner {
  public:
@@ -40,7 +39,7 @@ class LidarScanner {
   const Hdl32eConfig& config() const { return config_; }
 
   PointCloud scan(RayScene& scene, const PoseAt& vehicle_pose, int64_t stamp_ns, uint64_t seed,
-                  const ActorMover& move_actors = {}) const;
+                  const ActorPoses& actor_poses = {}) const;
 
   // The rays of one scan in firing order (cycle-major, then firing slot); scan() casts exactly these.
   std::vector<LidarRay> rays(const PoseAt& vehicle_pose, int64_t stamp_ns) const;
@@ -62,6 +61,8 @@ class LidarScanner {
   // Per firing slot: the beam's unit vector at zero yaw, with the slot's own yaw advance folded in.
   std::array<Eigen::Vector3f, kHdl32eLasers> slot_direction_;
   std::vector<Eigen::Vector2f> cycle_yaw_;  // (cos, sin) of each cycle's starting yaw
+  int keyframes_ = 2;                        // actor keyframes per scan, evenly spaced from the stamp
+  int64_t keyframe_step_ns_ = 0;
 };
 
 }  // namespace lidarloop

@@ -1,5 +1,6 @@
 #include "sim/ray_scene.hpp"
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -60,7 +61,7 @@ int RayScene::add_actor(int prototype, const Eigen::Isometry3d& pose) {
   RTCGeometry inst = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
   rtcSetGeometryInstancedScene(inst, prototypes_[prototype].scene);
   const unsigned geom_id = rtcAttachGeometry(top_, inst);
-  instances_.push_back({prototype, inst, geom_id, Eigen::Matrix3f::Identity(), true});
+  instances_.push_back({prototype, inst, geom_id, {}, true});
   if (instance_of_geom_.size() <= geom_id) instance_of_geom_.resize(geom_id + 1, -1);
   instance_of_geom_[geom_id] = int(instances_.size()) - 1;
   actors_.push_back(int(instances_.size()) - 1);
@@ -68,11 +69,19 @@ int RayScene::add_actor(int prototype, const Eigen::Isometry3d& pose) {
   return int(actors_.size()) - 1;
 }
 
-void RayScene::set_actor_pose(int actor, const Eigen::Isometry3d& pose) {
+void RayScene::set_actor_pose(int actor, const Eigen::Isometry3d& pose) { set_actor_motion(actor, {pose}); }
+
+void RayScene::set_actor_motion(int actor, const std::vector<Eigen::Isometry3d>& keyframes) {
+  if (keyframes.empty() || keyframes.size() > size_t(kMaxKeyframes))
+    throw std::invalid_argument("set_actor_motion: 1 to " + std::to_string(kMaxKeyframes) + " keyframes");
   Actor& a = instances_.at(actors_.at(actor));
-  const Eigen::Matrix<float, 3, 4> m = pose.matrix().topRows<3>().cast<float>();
-  rtcSetGeometryTransform(a.instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m.data());
-  a.rotation = m.leftCols<3>();
+  rtcSetGeometryTimeStepCount(a.instance, unsigned(keyframes.size()));
+  a.rotations.clear();
+  for (size_t k = 0; k < keyframes.size(); ++k) {
+    const Eigen::Matrix<float, 3, 4> m = keyframes[k].matrix().topRows<3>().cast<float>();
+    rtcSetGeometryTransform(a.instance, unsigned(k), RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m.data());
+    a.rotations.push_back(m.leftCols<3>());
+  }
   rtcCommitGeometry(a.instance);
 }
 
@@ -89,28 +98,54 @@ void RayScene::commit() {
   check_device(device_, "committing the scene");
 }
 
-bool RayScene::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float tnear, float tfar,
-                         RayHit& hit) const {
+RayHit RayScene::make_hit(unsigned inst_id, unsigned prim_id, float tfar, const Eigen::Vector3f& ng,
+                          float time) const {
+  const Actor& inst = instances_[instance_of_geom_[inst_id]];
+  // Embree reports instanced normals in the instance's object space; the nearest keyframe's
+  // rotation is close enough for an incidence angle.
+  const size_t k = size_t(std::lround(time * float(inst.rotations.size() - 1)));
+  return {tfar, (inst.rotations[k] * ng).normalized(), prototypes_[inst.prototype].materials[prim_id]};
+}
+
+bool RayScene::intersect(const Ray& ray, float tnear, float tfar, RayHit& hit) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
-  rh.ray.org_x = origin.x(), rh.ray.org_y = origin.y(), rh.ray.org_z = origin.z();
-  rh.ray.dir_x = direction.x(), rh.ray.dir_y = direction.y(), rh.ray.dir_z = direction.z();
-  rh.ray.tnear = tnear;
-  rh.ray.tfar = tfar;
-  rh.ray.time = 0;
-  rh.ray.mask = std::numeric_limits<unsigned>::max();
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
+  rh.ray.org_x = ray.origin.x(), rh.ray.org_y = ray.origin.y(), rh.ray.org_z = ray.origin.z();
+  rh.ray.dir_x = ray.direction.x(), rh.ray.dir_y = ray.direction.y(), rh.ray.dir_z = ray.direction.z();
+  rh.ray.tnear = tnear, rh.ray.tfar = tfar, rh.ray.time = ray.time;
+  rh.ray.mask = std::numeric_limits<unsigned>::max(), rh.ray.id = 0, rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(top_, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  const Actor& inst = instances_[instance_of_geom_[rh.hit.instID[0]]];
-  hit.range = rh.ray.tfar;
-  hit.normal = (inst.rotation * Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)).normalized();
-  hit.material = prototypes_[inst.prototype].materials[rh.hit.primID];
+  hit = make_hit(rh.hit.instID[0], rh.hit.primID, rh.ray.tfar, {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, ray.time);
   return true;
+}
+
+void RayScene::intersect8(const Ray* rays, int count, float tnear, float tfar, RayHit* hits, bool* found) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(64) int valid[kPacket];
+  alignas(64) RTCRayHit16 rh;
+  for (int k = 0; k < kPacket; ++k) {
+    const Ray& r = rays[k < count ? k : 0];
+    valid[k] = k < count ? -1 : 0;
+    rh.ray.org_x[k] = r.origin.x(), rh.ray.org_y[k] = r.origin.y(), rh.ray.org_z[k] = r.origin.z();
+    rh.ray.dir_x[k] = r.direction.x(), rh.ray.dir_y[k] = r.direction.y(), rh.ray.dir_z[k] = r.direction.z();
+    rh.ray.tnear[k] = tnear, rh.ray.tfar[k] = tfar, rh.ray.time[k] = r.time;
+    rh.ray.mask[k] = std::numeric_limits<unsigned>::max(), rh.ray.id[k] = 0, rh.ray.flags[k] = 0;
+    rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+  }
+  rtcIntersect16(valid, top_, &context, &rh);
+  for (int k = 0; k < count; ++k) {
+    found[k] = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+    if (found[k])
+      hits[k] = make_hit(rh.hit.instID[0][k], rh.hit.primID[k], rh.ray.tfar[k],
+                         {rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]}, rays[k].time);
+  }
 }
 
 }  // namespace lidarloop

@@ -4,6 +4,10 @@
 // Two levels: the world mesh and each actor type are built once as their own BVHs; the top-level
 // scene holds only instances of them. Moving an actor updates its instance transform and recommits
 // the top level (a handful of boxes), never the static world.
+//
+// Actors can also move during a scan: set_actor_motion() gives an instance one transform per
+// keyframe (Embree instance motion blur), and each ray carries its time within the keyframes' span, so
+// a whole scan is cast in one parallel pass with every actor where it was at that ray's instant.
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -12,6 +16,11 @@
 #include "sim/triangle_mesh.hpp"
 
 namespace lidarloop {
+
+struct Ray {
+  Eigen::Vector3f origin, direction;  // world frame, unit direction
+  float time = 0;                     // 0..1 across the actors' keyframes
+};
 
 struct RayHit {
   float range = 0;                // along the (unit) ray direction
@@ -30,14 +39,20 @@ class RayScene {
   int add_prototype(const TriangleMesh& mesh);  // an actor type; returns its id
   int add_actor(int prototype, const Eigen::Isometry3d& pose);
   void set_actor_pose(int actor, const Eigen::Isometry3d& pose);
+  // Poses at evenly spaced keyframes (2 to kMaxKeyframes) spanning ray times 0..1.
+  static constexpr int kMaxKeyframes = RTC_MAX_TIME_STEP_COUNT;
+  void set_actor_motion(int actor, const std::vector<Eigen::Isometry3d>& keyframes);
   void set_actor_visible(int actor, bool visible);
   size_t actor_count() const { return actors_.size(); }
   // Must be called after adding or moving actors and before casting.
   void commit();
 
-  // Nearest hit of a ray with unit direction within [tnear, tfar]; thread-safe between commits.
-  bool intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float tnear, float tfar,
-                 RayHit& hit) const;
+  // Nearest hit of a ray within [tnear, tfar]; thread-safe between commits.
+  bool intersect(const Ray& ray, float tnear, float tfar, RayHit& hit) const;
+  // The same for up to kPacket rays at once: Embree's packet traversal, much cheaper for coherent rays.
+  // found[k] tells whether ray k hit; hits[k] is set only then.
+  static constexpr int kPacket = 16;
+  void intersect8(const Ray* rays, int count, float tnear, float tfar, RayHit* hits, bool* found) const;
 
   RTCScene top_level() const { return top_; }  // for benchmarking bare rtcIntersect1
   size_t world_triangles() const { return world_triangles_; }
@@ -51,10 +66,11 @@ class RayScene {
     int prototype;
     RTCGeometry instance;
     unsigned geom_id;
-    Eigen::Matrix3f rotation;  // for bringing object-space normals to the world
+    std::vector<Eigen::Matrix3f> rotations;  // per keyframe, to bring object-space normals to the world
     bool visible;
   };
   Prototype make_prototype(const TriangleMesh& mesh) const;
+  RayHit make_hit(unsigned inst_id, unsigned prim_id, float tfar, const Eigen::Vector3f& ng, float time) const;
 
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;

@@ -75,7 +75,7 @@ static int bench_lidar(const Args& args) {
   for (int i = -2; i < scans; ++i) {  // two warm-up scans
     const int64_t stamp = int64_t(std::max(i, 0)) * config.scan_period_ns();
     auto t0 = Clock::now();
-    const PointCloud cloud = scanner.scan(*s.scene, trajectory, stamp, 1, s.mover);
+    const PointCloud cloud = scanner.scan(*s.scene, trajectory, stamp, 1, s.actor_poses);
     const double ours = ms_since(t0);
     const std::vector<LidarRay> rays = scanner.rays(trajectory, stamp);
     t0 = Clock::now();

@@ -48,7 +48,7 @@ static int run_scan(const Args& args) {
   const LidarScanner scanner(config, s.world.materials);
 
   const auto t0 = std::chrono::steady_clock::now();
-  const PointCloud cloud = scanner.scan(*s.scene, trajectory, 0, seed, s.mover);
+  const PointCloud cloud = scanner.scan(*s.scene, trajectory, 0, seed, s.actor_poses);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   std::cout << "scan         " << cloud.points.size() << " points from " << scanner.rays_per_scan() << " firings ("

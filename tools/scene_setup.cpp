@@ -42,8 +42,8 @@ SceneSetup make_scene(const std::string& world, const std::vector<StraightActor>
   }
   s.scene->commit();
   if (moving)
-    s.mover = [actors](int64_t t_ns, RayScene& scene) {
-      for (size_t i = 0; i < actors.size(); ++i) scene.set_actor_pose(int(i), actor_pose(actors[i], t_ns));
+    s.actor_poses = [actors](int64_t t_ns, std::vector<Eigen::Isometry3d>& poses) {
+      for (size_t i = 0; i < actors.size(); ++i) poses[i] = actor_pose(actors[i], t_ns);
     };
   return s;
 }

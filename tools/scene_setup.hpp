@@ -25,7 +25,7 @@ struct SceneSetup {
   LoadedWorld world;
   std::unique_ptr<RayScene> scene;
   std::vector<StraightActor> actors;
-  ActorMover mover;  // empty when no actor moves
+  ActorPoses actor_poses;  // empty when no actor moves
 };
 SceneSetup make_scene(const std::string& world, const std::vector<StraightActor>& actors, int threads);
 
