@@ -1,0 +1,8 @@
+# Runs COMMAND and checks its exit code and that its output contains EXPECT_OUTPUT.
+execute_process(COMMAND ${COMMAND} WORKING_DIRECTORY ${WORKDIR} RESULT_VARIABLE code OUTPUT_VARIABLE out
+                ERROR_VARIABLE err TIMEOUT 120)
+string(FIND "${out}${err}" "${EXPECT_OUTPUT}" found)
+if(NOT code EQUAL EXPECT_EXIT OR found EQUAL -1)
+  message(FATAL_ERROR "expected exit ${EXPECT_EXIT} and output containing '${EXPECT_OUTPUT}'\n"
+                      "got exit ${code}\nstdout: ${out}\nstderr: ${err}")
+endif()

@@ -1,0 +1,99 @@
+// Scans of the generated campus: the curbs a localizer will look for are where the map says, at the
+// height the world description gives them.
+#include <gtest/gtest.h>
+
+#include "sim/lidar_scanner.hpp"
+#include "sim/polyline.hpp"
+#include "test_support.hpp"
+#include "tools/ply_file.hpp"
+#include "tools/world_assets.hpp"
+
+namespace lidarloop {
+namespace {
+
+const LoadedWorld& campus() {
+  static const LoadedWorld w = load_world(test::data_path("maps/campus/world.yaml"));
+  return w;
+}
+
+// World-frame points of one noiseless scan from a vehicle standing at (x, y) heading east.
+std::vector<Eigen::Vector3d> scan_world(double x, double y) {
+  RayScene scene(campus().world.mesh);
+  const Hdl32eConfig config = test::noiseless_hdl32e();
+  const LidarScanner scanner(config, campus().materials);
+  const Eigen::Isometry3d vehicle(Eigen::Translation3d(x, y, 0));
+  const PointCloud cloud = scanner.scan(scene, constant_twist(vehicle, 0, 0, 0), 0, 1);
+  std::vector<Eigen::Vector3d> out;
+  const Eigen::Isometry3d sensor = vehicle * config.mount();
+  for (const auto& p : cloud.points) out.push_back(sensor * Eigen::Vector3d(p.x, p.y, p.z));
+  return out;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? NAN : v[v.size() / 2];
+}
+
+TEST(CampusScan, CurbFacesShowTheConfiguredHeight) {
+  // On the south straight of the loop (centreline y = 0, 9 m wide, 0.15 m curbs), away from crosswalks.
+  const RoadSpec& loop = *campus().description.road("loop");
+  const double curb_y = -loop.width / 2;
+  const auto points = scan_world(220, -2.25);
+  std::vector<double> road, top, face;
+  for (const auto& p : points) {
+    if (std::abs(p.x() - 220) > 8) continue;
+    const double d = p.y() - curb_y;  // > 0 on the carriageway
+    if (d > 0.4 && d < 0.9) road.push_back(p.z());
+    if (d < -0.3 && d > -1.0) top.push_back(p.z());
+    if (std::abs(d) < 0.005) face.push_back(p.z());
+  }
+  ASSERT_GT(road.size(), 50u);
+  ASSERT_GT(top.size(), 50u);
+  ASSERT_GT(face.size(), 10u);
+  EXPECT_NEAR(median(road), 0.0, 0.01);
+  EXPECT_NEAR(median(top), loop.curb_height, 0.01);
+  // Points on the face itself span the step and never rise above the curb.
+  EXPECT_NEAR(*std::max_element(face.begin(), face.end()), loop.curb_height, 0.01);
+  EXPECT_LT(*std::min_element(face.begin(), face.end()), loop.curb_height - 0.05);
+}
+
+TEST(CampusScan, CurbsInTheScanLieOnTheCurbMap) {
+  // Every point on a curb face (between asphalt and curb top) is within 2 cm of a curb line.
+  const auto points = scan_world(300, 150);  // central avenue, near the four-way intersection
+  const auto& curbs = campus().world.curbs;
+  int face_points = 0;
+  for (const auto& p : points) {
+    if (p.z() < 0.03 || p.z() > 0.10 || p.head<2>().norm() > 1e4) continue;
+    double best = 1e9;
+    for (const auto& line : curbs) {
+      const double s = project_onto_polyline(line, p.head<2>());
+      best = std::min(best, (sample_polyline(line, s).point - p.head<2>()).norm());
+    }
+    if (best > 0.5) continue;  // not a curb (an object's base, a car's tyre)
+    ++face_points;
+    EXPECT_LT(best, 0.02) << p.transpose();
+  }
+  EXPECT_GT(face_points, 30);
+}
+
+TEST(CampusScan, PlyRoundTripKeepsEveryField) {
+  PointCloud cloud;
+  cloud.stamp_ns = 123456789012;
+  cloud.points = {{1.5f, -2.25f, 0.125f, 37, 4, 46080}, {-80.0f, 3.0f, -1.9f, 212, 31, 99996928}};
+  const std::string path = testing::TempDir() + "/roundtrip.ply";
+  write_ply(path, cloud);
+  const PointCloud back = read_ply(path);
+  EXPECT_EQ(back.stamp_ns, cloud.stamp_ns);
+  ASSERT_EQ(back.points.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back.points[i].x, cloud.points[i].x);
+    EXPECT_EQ(back.points[i].z, cloud.points[i].z);
+    EXPECT_EQ(back.points[i].intensity, cloud.points[i].intensity);
+    EXPECT_EQ(back.points[i].ring, cloud.points[i].ring);
+    EXPECT_NEAR(double(back.points[i].t_ns), double(cloud.points[i].t_ns), 8.0);  // float seconds in the file
+  }
+  EXPECT_THROW(read_ply(test::data_path("maps/campus/world.yaml")), InputError);
+}
+
+}  // namespace
+}  // namespace lidarloop
