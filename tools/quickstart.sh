@@ -19,9 +19,10 @@ build() {  # build DIR [cmake options...]
 if [ "$what" = run ]; then
   build build -DLIDARLOOP_BUILD_TESTS=OFF
   mkdir -p build/out
-  # Main job: one HDL-32E scan on the campus, driving at 10 m/s past a parked bus with a car coming.
+  # Main job: one HDL-32E scan on the campus, driving at 10 m/s behind a truck, past a bus parked on
+  # the other side of the road, while a pedestrian walks onto the sidewalk.
   build/tools/lidarloop scan --world campus --pose 240,-2.25,0 --speed 10 \
-    --actor bus,252,-3.2,0 --actor car,275,2.25,180,10 \
+    --actor bus,252,3.0,180 --actor truck,262,-2.25,0,8 --actor pedestrian,236,-6.5,90,1.4 \
     --out build/out/scan.ply --png build/out/scan.png
   exit 0
 fi
