@@ -61,6 +61,8 @@ CurbMap read_curb_map(const std::string& path) {
   map.origin = {coordinate(meta["origin"][1], path, "origin latitude"),
                 coordinate(meta["origin"][0], path, "origin longitude"),
                 coordinate(meta["origin"][2], path, "origin altitude")};
+  if (std::abs(map.origin.lat_deg) > 85 || std::abs(map.origin.lon_deg) > 180)
+    throw InputError(path + ": lidarloop.origin is outside the range a local frame supports");
   if (meta.contains("world") && meta["world"].is_string()) map.world = meta["world"];
   const LocalFrame frame(map.origin);
   for (size_t i = 0; i < doc["features"].size(); ++i) {

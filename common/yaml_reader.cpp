@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 namespace lidarloop {
@@ -42,8 +43,10 @@ void YamlReader::expect_sequence(const YAML::Node& node, std::string_view what) 
 }
 
 void YamlReader::allow_keys(const YAML::Node& map, std::initializer_list<std::string_view> allowed) const {
+  std::set<std::string> seen;
   for (const auto& entry : map) {
     const std::string key = entry.first.Scalar();
+    if (!seen.insert(key).second) fail(entry.first, "key '" + key + "' appears twice");
     bool known = false;
     for (auto a : allowed) known = known || key == a;
     if (known) continue;

@@ -44,7 +44,11 @@ static double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return
 
 Polyline2d fillet_polyline(const Polyline2d& line, double radius, bool closed, double max_step_rad) {
   const size_t n = line.size();
-  if (radius <= 0 || n < 3) return line;
+  if (radius <= 0 || n < 3) {
+    Polyline2d out = line;
+    if (closed && n > 0) out.push_back(line.front());
+    return out;
+  }
   Polyline2d out;
   if (!closed) out.push_back(line.front());
   const size_t first = closed ? 0 : 1, last = closed ? n : n - 1;
@@ -104,7 +108,13 @@ bool segments_intersect(const Eigen::Vector2d& a0, const Eigen::Vector2d& a1, co
                         const Eigen::Vector2d& b1) {
   const double d1 = cross(a1 - a0, b0 - a0), d2 = cross(a1 - a0, b1 - a0);
   const double d3 = cross(b1 - b0, a0 - b0), d4 = cross(b1 - b0, a1 - b0);
-  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
+  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
+  // Touching or overlapping: an end point of one segment lies on the other.
+  auto on = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q0, const Eigen::Vector2d& q1, double c) {
+    return c == 0 && p.x() >= std::min(q0.x(), q1.x()) && p.x() <= std::max(q0.x(), q1.x()) &&
+           p.y() >= std::min(q0.y(), q1.y()) && p.y() <= std::max(q0.y(), q1.y());
+  };
+  return on(b0, a0, a1, d1) || on(b1, a0, a1, d2) || on(a0, b0, b1, d3) || on(a1, b0, b1, d4);
 }
 
 std::optional<std::pair<size_t, size_t>> find_self_intersection(const Polyline2d& line, bool closed) {

@@ -22,6 +22,7 @@ double project_onto_polyline(const Polyline2d& line, const Eigen::Vector2d& p);
 
 // Rounds every interior corner (and the closing corner of a closed line) with a circular arc of
 // `radius`, shrunk where the adjacent segments are too short; arcs are split every `max_step_rad`.
+// A closed line is given without its repeated first point and returned with it.
 Polyline2d fillet_polyline(const Polyline2d& line, double radius, bool closed, double max_step_rad);
 
 // The line shifted sideways by `offset` (positive = left of the direction of travel), mitred joins.

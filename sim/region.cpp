@@ -121,7 +121,8 @@ Paths intersect(const Paths& a, const Paths& b) { return boolean(a, b, ClipperLi
 
 Paths closing(const Paths& region, double radius) {
   if (radius <= 0) return unite(region, {});
-  return offset(offset(region, radius), -radius);
+  // Offsetting back loses a few millimetres at convex corners; the union keeps the original whole.
+  return unite(region, offset(offset(region, radius), -radius));
 }
 
 std::vector<Polyline2d> clip_lines_outside(const std::vector<Polyline2d>& lines, const Paths& region) {

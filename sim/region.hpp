@@ -33,9 +33,10 @@ std::vector<Polyline2d> clip_lines_outside(const std::vector<Polyline2d>& lines,
 bool contains(const Paths& region, const Eigen::Vector2d& p);
 double area(const Paths& region);
 
-// Triangulates a region as a horizontal surface whose height is given per vertex. The region is cut
-// into square tiles aligned to a global grid (so neighbouring regions share tile edges), keeping
-// triangles small and every piece a simple polygon.
+// Triangulates a region as a surface whose height is given per vertex, by a quadtree on a global grid
+// (so neighbouring regions share tile edges): squares wholly inside the region become two triangles
+// whatever their size; squares the region's edge crosses are split down to `tile_size`, and further
+// while a piece has a hole, so every piece ear-clipped is a small simple polygon.
 void mesh_region(const Paths& region, double tile_size, const std::function<float(const Eigen::Vector2d&)>& height,
                  MaterialId material, TriangleMesh& mesh);
 

@@ -12,6 +12,7 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kMaxArcStep = 3.0 * kDeg;  // fillet arcs are split every 3 degrees
 constexpr double kMinSegment = 0.01;        // m; shorter centreline segments are input errors
+constexpr double kMaxTurn = 170.0 * kDeg;   // sharper turns between segments are a road doubling back
 
 MarkingStyle read_marking(const YamlReader& y, const YAML::Node& n) {
   const std::string s = y.string(n, "marking");
@@ -65,7 +66,15 @@ RoadSpec read_road(const YamlReader& y, const YAML::Node& n, const RoadSpec& def
   if (auto hit = find_self_intersection(road.points, road.closed))
     y.fail(points, "road '" + road.name + "' intersects itself (segments " + std::to_string(hit->first) +
                        " and " + std::to_string(hit->second) + ")");
-  road.centreline = fillet_polyline(road.points, road.smoothing_radius, road.closed, kMaxArcStep);
+  for (size_t i = 1; i + 1 < road.points.size(); ++i) {
+    const Eigen::Vector2d a = road.points[i] - road.points[i - 1], b = road.points[i + 1] - road.points[i];
+    if (a.dot(b) < std::cos(kMaxTurn) * a.norm() * b.norm())
+      y.fail(points[i], "road '" + road.name + "' turns back on itself at point " + std::to_string(i));
+  }
+  // fillet_polyline takes a closed line without its repeated first point.
+  Polyline2d corners = road.points;
+  if (road.closed) corners.pop_back();
+  road.centreline = fillet_polyline(corners, road.smoothing_radius, road.closed, kMaxArcStep);
   return road;
 }
 

@@ -99,6 +99,18 @@ TEST(Geodetic, RoundTripAcrossUtmZoneBoundary) {
               kMillimetre);
 }
 
+TEST(Geodetic, RoundTripAcrossAntimeridian) {
+  // Longitudes jump from +180 to -180 here (Fiji); the local frame must not.
+  const Geodetic origin{-17.8, 179.999, 0.0};
+  expect_round_trip_on_grid(origin, 3000, 3000, 100);
+  const LocalFrame frame(origin);
+  const Eigen::Vector2d west = frame.to_local(origin.lat_deg, 179.989);   // 0.01 deg west of the origin
+  const Eigen::Vector2d east = frame.to_local(origin.lat_deg, -179.991);  // 0.01 deg east, across 180
+  EXPECT_NEAR(west.x(), -east.x(), kMillimetre);
+  EXPECT_NEAR(west.y(), east.y(), kMillimetre);
+  EXPECT_NEAR(east.x(), geodesic_distance(origin.lat_deg, origin.lon_deg, origin.lat_deg, -179.991), 0.01);
+}
+
 TEST(Geodetic, NorthIsMeridianArcLength) {
   // 0.001 deg of latitude north of the origin lies on the central meridian, where the transverse
   // Mercator northing is the meridian arc length: the geodesic distance, to the millimetre.
@@ -255,6 +267,14 @@ TEST(GeodeticCurbMapFile, MissingOrigin) {
                         R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {},
                             "geometry": {"type": "LineString", "coordinates": [[121.2, 31.2], [121.3, 31.3]]}}]})",
                         "missing lidarloop.origin");
+}
+
+TEST(GeodeticCurbMapFile, OriginOutOfRange) {
+  expect_curb_map_error("origin_range",
+                        R"({"type": "FeatureCollection", "lidarloop": {"origin": [121.2147, 95.0, 0]},
+                            "features": [{"type": "Feature", "properties": {}, "geometry": {"type": "LineString",
+                            "coordinates": [[121.2147, 31.2856], [121.2148, 31.2857]]}}]})",
+                        "origin");
 }
 
 }  // namespace

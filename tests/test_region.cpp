@@ -1,5 +1,6 @@
 // Planar region helpers on Clipper: triangulation, meshing, closing, strips, line clipping.
 // Known truth: shoelace areas of hand-made polygons and closed-form areas of fillets and strips.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -134,16 +135,26 @@ TEST(RegionMesh, SquareWithCircularHole) {
   }
 }
 
-TEST(RegionMesh, TrianglesAreNoLargerThanTheTile) {
-  // A large square fully covering many tiles: each tile becomes two triangles of at most tile size.
+TEST(RegionMesh, TilesFollowTheGlobalGrid) {
+  // A square not aligned with the tile grid: every vertex is on a grid line (a multiple of the tile)
+  // or on the region's edge, so neighbouring regions meshed separately share tile edges; triangles
+  // touching the edge are at most one tile (inside, whole covered squares may be larger).
   constexpr double kTile = 8.0, kHalf = 20.0;
   TriangleMesh mesh;
   region::mesh_region(region::rectangle({0, 0}, {1, 0}, kHalf, kHalf), kTile,
                       [](const Eigen::Vector2d&) { return 0.0f; }, 0, mesh);
   EXPECT_NEAR(mesh_area(mesh), 4 * kHalf * kHalf, 1e-3);
-  for (const auto& t : mesh.triangles)
+  auto on_grid_or_edge = [&](float v) {
+    return std::abs(std::abs(v) - kHalf) < 1e-4 || std::abs(v / kTile - std::round(v / kTile)) < 1e-6;
+  };
+  for (const auto& v : mesh.vertices) EXPECT_TRUE(on_grid_or_edge(v.x()) && on_grid_or_edge(v.y())) << v.transpose();
+  for (const auto& t : mesh.triangles) {
+    bool touches_edge = false;
+    for (uint32_t i : t) touches_edge = touches_edge || mesh.vertices[i].head<2>().cwiseAbs().maxCoeff() > kHalf - 1e-4;
+    if (!touches_edge) continue;
     for (int k = 0; k < 3; ++k)
       EXPECT_LE((mesh.vertices[t[k]] - mesh.vertices[t[(k + 1) % 3]]).norm(), kTile * std::sqrt(2.0) + 1e-3);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------- regions

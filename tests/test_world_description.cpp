@@ -1,5 +1,6 @@
 // Parsing and validating world descriptions (maps/<world>/world.yaml). Errors must be InputErrors of the
 // form "file:line:col: what is wrong", pointing at the offending node.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -111,7 +112,8 @@ TEST(WorldDescription, SmoothedCornerIsATangentArc) {
   const std::string yaml = kHeader + R"(roads:
   - {name: bend, points: [[0, 0], [100, 0], [100, 100]], smoothing_radius: 20}
 )";
-  const RoadSpec& r = *parse_world_description(yaml, kFile).road("bend");
+  const WorldDescription w = parse_world_description(yaml, kFile);
+  const RoadSpec& r = *w.road("bend");
   const Eigen::Vector2d centre(kLeg - kRadius, kRadius);
   EXPECT_NEAR(polyline_length(r.centreline), 2 * kLeg - 2 * kRadius + std::numbers::pi * kRadius / 2, 0.01);
   EXPECT_EQ(r.centreline.front(), Eigen::Vector2d(0, 0));
@@ -131,10 +133,34 @@ TEST(WorldDescription, ClosedRoadRepeatsItsFirstPoint) {
   const std::string yaml = kHeader + R"(roads:
   - {name: loop, closed: true, points: [[0, 0], [100, 0], [100, 50], [0, 50]]}
 )";
-  const RoadSpec& r = *parse_world_description(yaml, kFile).road("loop");
+  const WorldDescription w = parse_world_description(yaml, kFile);
+  const RoadSpec& r = *w.road("loop");
   EXPECT_TRUE(r.closed);
   EXPECT_EQ(r.centreline.front(), r.centreline.back());
   EXPECT_NEAR(polyline_length(r.centreline), 300.0, 1e-9);
+}
+
+TEST(WorldDescription, SmoothedClosedRoadRoundsEveryCorner) {
+  // A 100 m x 50 m loop with all four right-angle corners rounded (radius R): length 300 - 4 (2R - pi R/2).
+  constexpr double kRadius = 20.0, kPerimeter = 300.0, kChordTolerance = 0.05;
+  const std::string yaml = kHeader + R"(roads:
+  - {name: loop, closed: true, points: [[0, 0], [100, 0], [100, 50], [0, 50]], smoothing_radius: 20}
+)";
+  const WorldDescription w = parse_world_description(yaml, kFile);
+  const RoadSpec& r = *w.road("loop");
+  EXPECT_EQ(r.centreline.front(), r.centreline.back());
+  EXPECT_NEAR(polyline_length(r.centreline), kPerimeter - 4 * (2 * kRadius - std::numbers::pi * kRadius / 2),
+              kChordTolerance);
+  int zero_length = 0;
+  for (size_t i = 1; i < r.centreline.size(); ++i) zero_length += (r.centreline[i] - r.centreline[i - 1]).norm() < 1e-6;
+  EXPECT_EQ(zero_length, 0) << "zero-length centreline segments";
+  // Each corner is R (sqrt 2 - 1) from its arc.
+  for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(100, 0), Eigen::Vector2d(100, 50),
+                                       Eigen::Vector2d(0, 50)}) {
+    double nearest = INFINITY;
+    for (const auto& p : r.centreline) nearest = std::min(nearest, (p - corner).norm());
+    EXPECT_NEAR(nearest, kRadius * (std::sqrt(2.0) - 1), 0.01) << "corner " << corner.transpose();
+  }
 }
 
 TEST(WorldDescription, CrosswalkNearIsProjectedOntoTheRoad) {
@@ -251,14 +277,23 @@ TEST(WorldDescriptionErrors, SelfIntersectingClosedRoad) {
   expect_error(yaml, location(yaml, "points: [[0, 0], [10, 0], [0, 10], [10, 10]]", "[["), "intersects itself");
 }
 
-// LIBRARY BUG (see report): a road that doubles back over itself (a 180-degree turn between adjacent
-// segments) overlaps itself but find_self_intersection only tests non-adjacent segments, so it is accepted.
 TEST(WorldDescriptionErrors, RoadDoublingBackOnItself) {
   const std::string yaml = kHeader + R"(roads:
   - name: hairpin
     points: [[0, 0], [100, 0], [40, 0]]
 )";
-  expect_error(yaml, "name.yaml:5:13", "road 'hairpin' intersects itself");
+  // Reported at the point where it turns back.
+  expect_error(yaml, "name.yaml:5:22", "road 'hairpin' turns back on itself at point 1");
+}
+
+TEST(WorldDescriptionErrors, DuplicateKey) {
+  const std::string yaml = kHeader + R"(roads:
+  - name: main
+    points: [[0, 0], [100, 0]]
+    width: 8
+    width: 50
+)";
+  expect_error(yaml, "name.yaml:7:5", "width");
 }
 
 TEST(WorldDescriptionErrors, WidthOutOfRange) {
