@@ -5,6 +5,7 @@
 #include "sim/obj_file.hpp"
 #include "tools/commands.hpp"
 #include "tools/world_assets.hpp"
+#include "tools/world_map_png.hpp"
 
 namespace lidarloop {
 
@@ -27,6 +28,12 @@ static int run_world(const Args& args) {
     write_obj(*obj, w.world.mesh, w.materials);
     std::cout << "mesh         " << *obj << "\n";
   }
+  if (auto png = args.value("png")) {
+    const double resolution = args.number("resolution", 0.25);
+    if (resolution < 0.02 || resolution > 10) throw InputError("--resolution must be 0.02 to 10 m per pixel");
+    write_world_map_png(*png, w.world, w.materials, resolution);
+    std::cout << "picture      " << *png << "\n";
+  }
   if (auto curbs = args.value("curbs")) {
     write_curb_map(*curbs, w.world.curb_map());
     std::cout << "curb map     " << *curbs << "\n";
@@ -36,10 +43,12 @@ static int run_world(const Args& args) {
 
 Command world_command() {
   return {{"world",
-           "lidarloop world WORLD [--obj FILE.obj] [--curbs FILE.geojson]",
+           "lidarloop world WORLD [--obj FILE.obj] [--curbs FILE.geojson] [--png FILE.png]",
            "Build a world (a name under maps/ or a world.yaml path); print its size, export mesh and curbs.",
            {{"obj", "FILE", "write the triangle mesh as Wavefront OBJ (one usemtl group per material)"},
-            {"curbs", "FILE", "write the curb map as GeoJSON LineStrings in WGS-84"}},
+            {"curbs", "FILE", "write the curb map as GeoJSON LineStrings in WGS-84"},
+            {"png", "FILE", "write a top view coloured by material, curbs in green"},
+            {"resolution", "M", "metres per pixel of the top view (default 0.25)"}},
            1, 1},
           run_world};
 }

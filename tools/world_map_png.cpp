@@ -1,0 +1,56 @@
+#include "tools/world_map_png.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/input_error.hpp"
+
+namespace lidarloop {
+
+// Colours (BGR) by material name; anything else is drawn grey.
+static cv::Scalar colour(const std::string& material) {
+  static const std::map<std::string, cv::Scalar> table = {
+      {"asphalt", {60, 60, 60}},         {"lane_paint", {255, 255, 255}}, {"crosswalk_paint", {235, 235, 235}},
+      {"curb_concrete", {170, 170, 170}}, {"sidewalk", {150, 160, 175}},  {"grass", {70, 140, 70}},
+      {"building", {120, 140, 190}},     {"vegetation", {40, 100, 40}},   {"vehicle_paint", {200, 80, 40}},
+      {"glass", {230, 200, 150}},        {"tyre", {20, 20, 20}},          {"metal", {180, 180, 200}},
+      {"retro_reflector", {0, 215, 255}}};
+  const auto it = table.find(material);
+  return it == table.end() ? cv::Scalar(128, 128, 128) : it->second;
+}
+
+void write_world_map_png(const std::string& path, const World& world, const MaterialTable& materials,
+                         double metres_per_pixel) {
+  const Eigen::Vector2d size = world.bounds.sizes() / metres_per_pixel;
+  if (size.maxCoeff() > 20000) throw InputError(path + ": picture would be too large; use a coarser resolution");
+  cv::Mat image(int(std::ceil(size.y())), int(std::ceil(size.x())), CV_8UC3, cv::Scalar(0, 0, 0));
+  auto pixel = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d d = (p - world.bounds.min()) / metres_per_pixel;
+    return cv::Point(int(std::lround(d.x())), image.rows - 1 - int(std::lround(d.y())));
+  };
+  const TriangleMesh& mesh = world.mesh;
+  std::vector<size_t> order(mesh.triangles.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto top = [&](size_t i) {
+    const auto& t = mesh.triangles[i];
+    return std::max({mesh.vertices[t[0]].z(), mesh.vertices[t[1]].z(), mesh.vertices[t[2]].z()});
+  };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return top(a) < top(b); });
+  for (size_t i : order) {
+    const auto& t = mesh.triangles[i];
+    cv::Point corners[3];
+    for (int k = 0; k < 3; ++k) corners[k] = pixel(mesh.vertices[t[k]].head<2>().cast<double>());
+    cv::fillConvexPoly(image, corners, 3, colour(materials[mesh.materials[i]].name), cv::LINE_8);
+  }
+  for (const auto& line : world.curbs)
+    for (size_t i = 1; i < line.size(); ++i)
+      cv::line(image, pixel(line[i - 1]), pixel(line[i]), cv::Scalar(80, 220, 80), 1, cv::LINE_AA);
+  if (!cv::imwrite(path, image)) throw InputError(path + ": cannot write PNG");
+}
+
+}  // namespace lidarloop
