@@ -126,8 +126,7 @@ struct Builder {
 
   void check_off_carriageway(const std::vector<Eigen::Vector2d>& footprint, const std::string& where,
                              const std::string& what, const region::Paths& area, const std::string& area_name) {
-    ClipperLib::Path poly;
-    for (const auto& p : footprint) poly.push_back(region::to_path({p})[0]);
+    ClipperLib::Path poly = region::to_path(footprint);
     if (!ClipperLib::Orientation(poly)) std::reverse(poly.begin(), poly.end());
     if (region::area(region::intersect({poly}, area)) > 1e-4)
       throw InputError(where + ": " + what + " overlaps the " + area_name);
@@ -137,7 +136,7 @@ struct Builder {
     const auto& g = desc.geometry;
     Eigen::AlignedBox2d box;
     for (const auto& path : world.sidewalks)
-      for (const auto& p : path) box.extend(region::to_polyline({p}, false)[0]);
+      for (const auto& p : region::to_polyline(path, false)) box.extend(p);
     for (const auto& b : desc.buildings) box.extend(b.centre + Eigen::Vector2d::Constant(b.size.norm()));
     for (const auto& b : desc.buildings) box.extend(b.centre - Eigen::Vector2d::Constant(b.size.norm()));
     box.min() -= Eigen::Vector2d::Constant(g.margin);
@@ -189,10 +188,11 @@ struct Builder {
       for (int k = 0; k < stripes; ++k) {
         const double lateral = (k - (stripes - 1) / 2.0) * period;
         const Eigen::Vector2d centre = s.point + n * lateral;
-        const auto rect = region::rectangle(centre, s.tangent, c.width / 2, g.crosswalk_stripe / 2)[0];
-        std::array<Eigen::Vector2f, 4> corners;
-        for (int i = 0; i < 4; ++i) corners[i] = region::to_polyline({rect[i]}, false)[0].cast<float>();
-        add_flat_quad(world.mesh, corners, z, zebra);
+        const Polyline2d rect =
+            region::to_polyline(region::rectangle(centre, s.tangent, c.width / 2, g.crosswalk_stripe / 2)[0], false);
+        add_flat_quad(world.mesh, {rect[0].cast<float>(), rect[1].cast<float>(), rect[2].cast<float>(),
+                                   rect[3].cast<float>()},
+                      z, zebra);
       }
     }
     for (const auto& sl : desc.stop_lines) {
