@@ -14,6 +14,8 @@ struct Command {
 Command world_command();
 Command scan_command();
 Command bench_command();
+Command validate_command();
+Command simulate_command();
 
 // --threads N: 0 means all cores. Returns the effective count.
 int thread_count(const Args& args);

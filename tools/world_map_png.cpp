@@ -25,7 +25,7 @@ static cv::Scalar colour(const std::string& material) {
 }
 
 void write_world_map_png(const std::string& path, const World& world, const MaterialTable& materials,
-                         double metres_per_pixel) {
+                         double metres_per_pixel, const std::vector<MapOverlay>& overlays) {
   const Eigen::Vector2d size = world.bounds.sizes() / metres_per_pixel;
   if (size.maxCoeff() > 20000) throw InputError(path + ": picture would be too large; use a coarser resolution");
   cv::Mat image(int(std::ceil(size.y())), int(std::ceil(size.x())), CV_8UC3, cv::Scalar(0, 0, 0));
@@ -50,6 +50,10 @@ void write_world_map_png(const std::string& path, const World& world, const Mate
   for (const auto& line : world.curbs)
     for (size_t i = 1; i < line.size(); ++i)
       cv::line(image, pixel(line[i - 1]), pixel(line[i]), cv::Scalar(80, 220, 80), 1, cv::LINE_AA);
+  for (const auto& o : overlays)
+    for (size_t i = 1; i < o.line.size(); ++i)
+      cv::line(image, pixel(o.line[i - 1]), pixel(o.line[i]), cv::Scalar(o.bgr[0], o.bgr[1], o.bgr[2]), o.thickness,
+               cv::LINE_AA);
   if (!cv::imwrite(path, image)) throw InputError(path + ": cannot write PNG");
 }
 

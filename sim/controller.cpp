@@ -1,0 +1,95 @@
+#include "sim/controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lidarloop {
+
+constexpr double kProjectBehind = 3.0, kProjectAhead = 10.0;  // m: where the car can be one step later
+constexpr double kCurvatureLookStep = 2.0;                    // m between curvature samples ahead
+constexpr double kStandstill = 0.05;                          // m/s
+constexpr double kHoldBrake = -1.0;                           // m/s^2 while standing
+constexpr double kIntegralLimit = 3.0;                        // m: anti-windup of the speed PI
+
+PathController::PathController(const Path& path, double cruise_speed, std::vector<Wait> stops,
+                               const VehicleParams& vehicle, const ControllerParams& params)
+    : path_(path), cruise_(cruise_speed), stops_(std::move(stops)), vehicle_(vehicle), p_(params) {
+  std::sort(stops_.begin(), stops_.end(), [](const Wait& a, const Wait& b) { return a.at < b.at; });
+}
+
+double PathController::project(const Eigen::Vector2d& p, double guess) const {
+  return path_.project(p, guess - kProjectBehind, guess + kProjectAhead);
+}
+
+double PathController::target_speed(double s, double speed) const {
+  double v = cruise_;
+  // Curvature ahead, as far as it takes to brake comfortably from the current speed.
+  const double horizon = speed * speed / (2 * p_.comfort_decel) + kCurvatureLookStep;
+  for (double ahead = 0; ahead <= horizon; ahead += kCurvatureLookStep) {
+    const double kappa = std::abs(path_.curvature_at(s + ahead));
+    if (kappa > 1e-6) {
+      const double v_curve = std::sqrt(p_.max_lateral_accel / kappa);
+      // Allowed now: what still lets us brake to v_curve by the time we get there.
+      v = std::min(v, std::sqrt(v_curve * v_curve + 2 * p_.comfort_decel * ahead));
+    }
+  }
+  auto brake_for = [&](double distance) {
+    v = std::min(v, std::sqrt(std::max(0.0, 2 * p_.comfort_decel * (distance - p_.stop_tolerance / 2))));
+  };
+  if (next_stop_ < stops_.size()) brake_for(stops_[next_stop_].at - s);
+  if (!path_.closed) brake_for(path_.length - s);
+  return v;
+}
+
+ControllerCommand PathController::update(int64_t t_ns, const Pose2d& rear, double speed) {
+  const double dt = last_ns_ < 0 ? 0.0 : double(t_ns - last_ns_) * 1e-9;
+  last_ns_ = t_ns;
+  const Eigen::Vector2d rear_xy(rear.x, rear.y), heading(std::cos(rear.yaw), std::sin(rear.yaw));
+  progress_ = progress_ < 0 ? path_.project(rear_xy) : project(rear_xy, progress_);
+
+  // Steering, on the front axle's projection previewed by the actuator lag.
+  const double wheelbase = vehicle_.wheelbase();
+  const Eigen::Vector2d front = rear_xy + heading * wheelbase;
+  const double s_front = project(front, progress_ + wheelbase);
+  const Pose2d at_front = path_.pose_at(s_front);
+  const Eigen::Vector2d left(-std::sin(at_front.yaw), std::cos(at_front.yaw));
+  const double cross_track = (front - Eigen::Vector2d(at_front.x, at_front.y)).dot(left);
+  const double s_ref = s_front + speed * p_.preview_s;
+  const double heading_error = std::remainder(path_.pose_at(s_ref).yaw - rear.yaw, 2 * M_PI);
+  const double kappa = path_.curvature_at(s_ref);
+  // Understeer gradient K of the single-track model (Eq. 19 in steady state): delta = (L + K v^2) kappa.
+  const double K = vehicle_.mass / wheelbase *
+                   (vehicle_.lr / (2 * vehicle_.cornering_stiffness_front) -
+                    vehicle_.lf / (2 * vehicle_.cornering_stiffness_rear));
+  const double feed_forward = std::atan(wheelbase * kappa) + K * speed * speed * kappa;
+  const double steer = feed_forward + p_.heading_gain * heading_error -
+                       std::atan2(p_.stanley_gain * cross_track, speed + p_.stanley_softening);
+
+  // Speed.
+  ControllerCommand out;
+  out.progress = progress_;
+  const Pose2d on_path = path_.pose_at(progress_);
+  out.cross_track = (rear_xy - Eigen::Vector2d(on_path.x, on_path.y))
+                        .dot(Eigen::Vector2d(-std::sin(on_path.yaw), std::cos(on_path.yaw)));
+  if (next_stop_ < stops_.size()) {
+    const Wait& stop = stops_[next_stop_];
+    const bool at_stop = std::abs(stop.at - progress_) <= p_.stop_tolerance || progress_ > stop.at;
+    if (at_stop && speed < kStandstill) {
+      if (stopped_since_ns_ < 0) stopped_since_ns_ = t_ns;
+      if (double(t_ns - stopped_since_ns_) * 1e-9 >= stop.duration_s) ++next_stop_, stopped_since_ns_ = -1;
+    }
+  }
+  const double v_target = target_speed(progress_, speed);
+  if (v_target < kStandstill && speed < kStandstill) {
+    integral_ = 0;
+    out.command = {steer, kHoldBrake};
+    out.finished = !path_.closed && path_.length - progress_ <= p_.stop_tolerance;
+    return out;
+  }
+  const double error = v_target - speed;
+  integral_ = std::clamp(integral_ + error * dt, -kIntegralLimit, kIntegralLimit);
+  out.command = {steer, p_.speed_kp * error + p_.speed_ki * integral_};
+  return out;
+}
+
+}  // namespace lidarloop

@@ -1,0 +1,99 @@
+#pragma once
+// A scenario (scenarios/*.yaml): the world, how long, the seed, the ego's route and speed, sensor
+// overrides, traffic, the localizer to test and the thresholds it must meet. Loading checks syntax,
+// types, ranges and unknown keys (file:line:col); resolving against the world builds the paths and
+// checks that they stay on the road network.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sim/can_model.hpp"
+#include "sim/controller.hpp"
+#include "sim/gps_model.hpp"
+#include "sim/hdl32e.hpp"
+#include "sim/path.hpp"
+#include "sim/traffic.hpp"
+#include "sim/vehicle_model.hpp"
+#include "sim/world_builder.hpp"
+
+namespace lidarloop {
+
+struct PathSpec {
+  std::string where;
+  enum class Kind { road, waypoints, crosswalk } kind = Kind::road;
+  // kind == road: a lane of a road
+  std::string road;
+  Lane lane = Lane::right;
+  bool backward = false;
+  std::optional<double> offset;
+  // kind == waypoints
+  Polyline2d waypoints;
+  double smoothing_radius = 0;
+  bool closed = false;
+  // kind == crosswalk: across the road at crosswalk number `crosswalk` of the world
+  int crosswalk = -1;
+  bool from_left = false;
+};
+
+struct TrafficSpec {
+  std::string where;
+  ActorType type = ActorType::car;
+  bool parked = false;
+  PathSpec path;                       // when moving
+  Eigen::Vector2d position{0, 0};      // when parked
+  double yaw = 0;                      // when parked, rad
+  double start_at = 0;                 // arc length on the path at t = 0, m
+  double speed = 0;                    // m/s
+  double depart_s = 0;                 // when it starts moving
+  std::vector<Wait> waits;
+};
+
+struct EgoSpec {
+  std::string where;
+  PathSpec route;
+  double start_at = 0;                 // arc length on the route where the rear axle starts, m
+  double speed = 10.0;                 // cruise speed, m/s
+  double initial_speed = 0;            // m/s at t = 0
+  std::vector<Wait> stops;             // arc lengths along the route (unwrapped on loops)
+  VehicleParams vehicle;
+  ControllerParams controller;
+};
+
+struct PassThresholds {
+  std::optional<double> lateral_rmse_m, longitudinal_rmse_m, heading_rmse_deg, max_position_error_m;
+};
+
+struct Scenario {
+  std::string file;
+  std::string world = "campus";        // a name under maps/ or a path
+  double duration_s = 60;
+  uint64_t seed = 1;
+  EgoSpec ego;
+  Hdl32eConfig lidar;
+  CanConfig can;
+  GpsConfig gps;
+  RtkConfig rtk;
+  std::vector<TrafficSpec> traffic;
+  std::string localizer_method = "proposed";
+  bool closed_loop = false;
+  PassThresholds pass;
+  int scan_every = 10;                 // simulate: write every Nth scan as PLY
+
+  int64_t duration_ns() const { return static_cast<int64_t>(duration_s * 1e9 + 0.5); }
+};
+
+Scenario load_scenario(const std::string& path);
+Scenario parse_scenario(const std::string& yaml_text, const std::string& name);
+
+// The localizer methods a scenario may name (the paper's baselines and its proposal).
+const std::vector<std::string>& localizer_methods();
+
+struct ResolvedScenario {
+  Path ego_route;
+  std::vector<ActorPlan> actors;
+};
+// Builds every path on `world` and checks it: vehicles stay on the carriageway, pedestrians and
+// cyclists on the carriageway or sidewalks. InputError names the scenario entry's file:line:col.
+ResolvedScenario resolve_scenario(const Scenario& scenario, const WorldDescription& description, const World& world);
+
+}  // namespace lidarloop

@@ -1,0 +1,112 @@
+#include "sim/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace lidarloop {
+
+constexpr int64_t kControlPeriodNs = 10'000'000;  // the driver acts at 100 Hz
+constexpr int64_t kTruthPeriodNs = 10'000'000;    // ground truth recorded at 100 Hz
+// Seeds of the sensors' random streams, derived from the scenario seed so each is independent.
+constexpr uint64_t kCanStream = 1, kGpsStream = 2, kRtkStream = 3, kLidarStream = 4;
+
+static Eigen::Isometry3d to_isometry(const Pose2d& p) {
+  return Eigen::Translation3d(p.x, p.y, 0) * Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ());
+}
+
+Simulation::Simulation(const Scenario& scenario, const WorldDescription& description, const World& world,
+                       const MaterialTable& materials, const std::string& actors_dir, int threads)
+    : scenario_(scenario),
+      resolved_(resolve_scenario(scenario, description, world)),
+      scene_(std::make_unique<RayScene>(world.mesh, threads)),
+      scanner_(scenario.lidar, materials),
+      vehicle_(scenario.ego.vehicle,
+               VehicleModel::state_at(scenario.ego.vehicle, resolved_.ego_route.pose_at(scenario.ego.start_at),
+                                      scenario.ego.initial_speed)),
+      controller_(resolved_.ego_route, scenario.ego.speed, scenario.ego.stops, scenario.ego.vehicle,
+                  scenario.ego.controller),
+      can_(scenario.can, mix64(scenario.seed ^ kCanStream)),
+      gps_(scenario.gps, LocalFrame(description.origin), mix64(scenario.seed ^ kGpsStream)),
+      rtk_(scenario.rtk, LocalFrame(description.origin), mix64(scenario.seed ^ kRtkStream)),
+      control_period_ns_(kControlPeriodNs) {
+  std::map<ActorType, int> prototypes;
+  for (const auto& actor : resolved_.actors) {
+    if (!prototypes.count(actor.type))
+      prototypes[actor.type] = scene_->add_prototype(load_actor_mesh(actors_dir, actor.type, materials));
+    scene_->add_actor(prototypes[actor.type], actor_pose(actor, 0));
+  }
+  scene_->commit();
+  trajectory_.push_back(vehicle_.rear_axle_pose());
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::set_pose_source(std::function<Pose2d(int64_t, const Pose2d&)> source) {
+  pose_source_ = std::move(source);
+}
+
+void Simulation::run(StreamSink& sink, const std::function<void(double)>& progress) {
+  const int64_t chunk = scenario_.lidar.scan_period_ns() * 10;
+  while (now_ < end_ns()) {
+    advance_to(std::min(end_ns(), now_ + chunk), sink);
+    if (progress) progress(double(now_) / double(end_ns()));
+  }
+}
+
+void Simulation::advance_to(int64_t t_ns, StreamSink& sink) {
+  t_ns = std::min(t_ns, end_ns());
+  while (now_ + scenario_.ego.vehicle.step_ns <= t_ns) step(sink);
+}
+
+void Simulation::step(StreamSink& sink) {
+  const VehicleParams& vp = scenario_.ego.vehicle;
+  if (now_ % control_period_ns_ == 0) {
+    const Pose2d truth = vehicle_.rear_axle_pose();
+    const Pose2d believed = pose_source_ ? pose_source_(now_, truth) : truth;
+    command_ = controller_.update(now_, believed, vehicle_.state().vx);
+  }
+  vehicle_.step(command_.command);
+  now_ += vp.step_ns;
+  const Pose2d pose = vehicle_.rear_axle_pose();
+  trajectory_.push_back(pose);
+
+  if (now_ % can_.period_ns() == 0) can_.measure(now_, vehicle_.wheel_speeds(), vehicle_.steering_wheel_angle());
+  for (const CanFrame& f : can_.deliver(now_)) sink.on_can(f);
+  if (now_ % kTruthPeriodNs == 0) {
+    const VehicleState& s = vehicle_.state();
+    sink.on_truth({now_, pose, s.vx, s.yaw_rate, s.steer, command_.cross_track});
+  }
+  if (now_ % gps_.period_ns() == 0) sink.on_gps(gps_.sample(now_, pose));
+  if (now_ % rtk_.period_ns() == 0) sink.on_rtk(rtk_.sample(now_, pose));
+  if (now_ - trajectory_start_ns_ >= scenario_.lidar.scan_period_ns()) emit_scan(sink);
+}
+
+void Simulation::emit_scan(StreamSink& sink) {
+  // The scan that started at trajectory_start_ns_ is complete: the vehicle's path through it is known.
+  const int64_t stamp = trajectory_start_ns_, step_ns = scenario_.ego.vehicle.step_ns;
+  const std::vector<Pose2d>& poses = trajectory_;
+  const PoseAt vehicle_pose = [&](int64_t t) {
+    const double u = double(t - stamp) / double(step_ns);
+    const size_t i = std::min(poses.size() - 2, size_t(std::max(0.0, std::floor(u))));
+    const double f = std::clamp(u - double(i), 0.0, 1.0);
+    const Pose2d &a = poses[i], &b = poses[i + 1];
+    return to_isometry({a.x + f * (b.x - a.x), a.y + f * (b.y - a.y),
+                        a.yaw + f * std::remainder(b.yaw - a.yaw, 2 * M_PI)});
+  };
+  const auto& actors = resolved_.actors;
+  const ActorPoses actor_poses = [&](int64_t t, std::vector<Eigen::Isometry3d>& out) {
+    for (size_t i = 0; i < actors.size(); ++i) out[i] = actor_pose(actors[i], t);
+  };
+  const PointCloud cloud =
+      scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses);
+  sink.on_scan(cloud, vehicle_pose(stamp) * scenario_.lidar.mount());
+  std::vector<ActorSample> states;
+  for (const auto& a : actors) states.push_back({a.name, a.type, actor_pose2d(a, stamp)});
+  sink.on_actors(stamp, states);
+  ++scan_index_;
+  trajectory_.erase(trajectory_.begin(), trajectory_.end() - 1);
+  trajectory_start_ns_ = now_;
+}
+
+}  // namespace lidarloop

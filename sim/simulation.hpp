@@ -1,0 +1,83 @@
+#pragma once
+// The simulator's main loop: the ego driven by its controller through Eq. 19, traffic on its paths,
+// and the sensors (HDL-32E, CAN, GPS, RTK truth) sampled at their own rates on an integer-nanosecond
+// clock. What it produces goes to a StreamSink, so file formats (CSV, MCAP) stay out of the loop.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/point_cloud.hpp"
+#include "sim/lidar_scanner.hpp"
+#include "sim/scenario.hpp"
+
+namespace lidarloop {
+
+struct TruthSample {
+  int64_t stamp_ns = 0;
+  Pose2d pose;             // rear axle centre (the vehicle frame origin)
+  double speed = 0;        // m/s
+  double yaw_rate = 0;     // rad/s
+  double steer = 0;        // front wheel angle, rad
+  double cross_track = 0;  // controller's lateral error to its route, m
+};
+
+struct ActorSample {
+  std::string name;
+  ActorType type;
+  Pose2d pose;
+};
+
+class StreamSink {
+ public:
+  virtual ~StreamSink() = default;
+  virtual void on_truth(const TruthSample&) {}
+  virtual void on_can(const CanFrame&) {}
+  virtual void on_gps(const GpsFix&) {}
+  virtual void on_rtk(const GpsFix&) {}
+  // sensor_pose: the LiDAR's pose in the world at the scan's stamp.
+  virtual void on_scan(const PointCloud&, const Eigen::Isometry3d& /*sensor_pose*/) {}
+  virtual void on_actors(int64_t /*stamp_ns*/, const std::vector<ActorSample>&) {}
+};
+
+class Simulation {
+ public:
+  Simulation(const Scenario& scenario, const WorldDescription& description, const World& world,
+             const MaterialTable& materials, const std::string& actors_dir, int threads);
+  ~Simulation();
+
+  // The pose the controller steers on: ground truth unless set (closed loop feeds the estimate).
+  void set_pose_source(std::function<Pose2d(int64_t t_ns, const Pose2d& truth)> source);
+
+  // Advances the clock to `t_ns` (at most the scenario's end), emitting every sample due on the way.
+  void advance_to(int64_t t_ns, StreamSink& sink);
+  void run(StreamSink& sink, const std::function<void(double fraction)>& progress = {});
+
+  int64_t now_ns() const { return now_; }
+  int64_t end_ns() const { return scenario_.duration_ns(); }
+  const ResolvedScenario& resolved() const { return resolved_; }
+  const VehicleModel& vehicle() const { return vehicle_; }
+
+ private:
+  void step(StreamSink& sink);
+  void emit_scan(StreamSink& sink);
+
+  Scenario scenario_;
+  ResolvedScenario resolved_;
+  std::unique_ptr<RayScene> scene_;
+  LidarScanner scanner_;
+  VehicleModel vehicle_;
+  PathController controller_;
+  CanModel can_;
+  GpsModel gps_;
+  RtkModel rtk_;
+  std::function<Pose2d(int64_t, const Pose2d&)> pose_source_;
+  ControllerCommand command_;
+  int64_t now_ = 0;
+  int64_t control_period_ns_;
+  int64_t scan_index_ = 0;
+  std::vector<Pose2d> trajectory_;  // rear-axle pose at every step of the scan being recorded
+  int64_t trajectory_start_ns_ = 0;
+};
+
+}  // namespace lidarloop

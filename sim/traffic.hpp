@@ -1,0 +1,36 @@
+#pragma once
+// Traffic actors: cars, buses, trucks, pedestrians and cyclists moving along paths with a speed,
+// a start time and waits, or parked. Their pose is a pure function of time, so a scan can ask where
+// each one was at any firing.
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "common/vehicle_messages.hpp"
+#include "sim/actor_assets.hpp"
+#include "sim/path.hpp"
+
+namespace lidarloop {
+
+struct Wait {
+  double at = 0;          // arc length along the path, m
+  double duration_s = 0;
+};
+
+struct ActorPlan {
+  std::string name;       // for logs: "<type>_<index>"
+  ActorType type = ActorType::car;
+  Path path;              // a parked actor has a one-point path at its position
+  double start_s = 0;     // arc length where it stands at t = 0, m
+  double speed = 0;       // m/s; 0 = parked
+  int64_t depart_ns = 0;  // when it starts moving
+  std::vector<Wait> waits;  // sorted by `at`
+};
+
+// Arc length travelled along the path by time t (waits included, clamped at the end of an open path).
+double actor_distance(const ActorPlan& plan, int64_t t_ns);
+Pose2d actor_pose2d(const ActorPlan& plan, int64_t t_ns);
+Eigen::Isometry3d actor_pose(const ActorPlan& plan, int64_t t_ns);  // footprint centre on the ground
+
+}  // namespace lidarloop
