@@ -17,6 +17,7 @@ struct CanConfig {
   double wheel_speed_resolution_mps = 0.01;   // quantisation step
   double wheel_speed_noise_mps = 0.02;        // 1 sigma, white
   double wheel_speed_scale_error = 0.005;     // reported = true * (1 + this): tyre radius error
+  double min_detectable_speed_mps = 0.1;      // below this a wheel reads 0 (too few encoder pulses)
   double steering_resolution_rad = 0.0017;    // ~0.1 deg at the steering wheel
   double steering_noise_rad = 0.002;          // 1 sigma at the steering wheel
   double steering_offset_rad = 0.0;           // constant bias at the steering wheel

@@ -10,6 +10,7 @@ constexpr double kCurvatureLookStep = 2.0;                    // m between curva
 constexpr double kStandstill = 0.05;                          // m/s
 constexpr double kHoldBrake = -1.0;                           // m/s^2 while standing
 constexpr double kIntegralLimit = 3.0;                        // m: anti-windup of the speed PI
+constexpr double kFeedForwardHorizon = 0.2;                   // s over which the target's slope is taken
 
 PathController::PathController(const Path& path, double cruise_speed, std::vector<Wait> stops,
                                const VehicleParams& vehicle, const ControllerParams& params)
@@ -44,33 +45,33 @@ double PathController::target_speed(double s, double speed) const {
 ControllerCommand PathController::update(int64_t t_ns, const Pose2d& rear, double speed) {
   const double dt = last_ns_ < 0 ? 0.0 : double(t_ns - last_ns_) * 1e-9;
   last_ns_ = t_ns;
-  const Eigen::Vector2d rear_xy(rear.x, rear.y), heading(std::cos(rear.yaw), std::sin(rear.yaw));
+  const Eigen::Vector2d rear_xy(rear.x, rear.y);
   progress_ = progress_ < 0 ? path_.project(rear_xy) : project(rear_xy, progress_);
 
-  // Steering, on the front axle's projection previewed by the actuator lag.
+  // Steering. Steady-state cornering on the single-track model (Eq. 19 with beta dot = psi double
+  // dot = 0) needs the front wheel angle (L + K v^2) kappa, with the understeer gradient K, and leaves
+  // the body pointing inside the path by the rear tyres' slip angle alpha_r = M l_f v^2 kappa / (2 C_r L).
+  // That is the feed-forward (taken a little ahead, for the steering lag); feedback on the rear axle's
+  // heading and cross-track errors (Stanley-like, critically damped around 2-3 rad/s) handles the rest.
   const double wheelbase = vehicle_.wheelbase();
-  const Eigen::Vector2d front = rear_xy + heading * wheelbase;
-  const double s_front = project(front, progress_ + wheelbase);
-  const Pose2d at_front = path_.pose_at(s_front);
-  const Eigen::Vector2d left(-std::sin(at_front.yaw), std::cos(at_front.yaw));
-  const double cross_track = (front - Eigen::Vector2d(at_front.x, at_front.y)).dot(left);
-  const double s_ref = s_front + speed * p_.preview_s;
-  const double heading_error = std::remainder(path_.pose_at(s_ref).yaw - rear.yaw, 2 * M_PI);
-  const double kappa = path_.curvature_at(s_ref);
-  // Understeer gradient K of the single-track model (Eq. 19 in steady state): delta = (L + K v^2) kappa.
+  const Pose2d on_path = path_.pose_at(progress_);
+  const Eigen::Vector2d left(-std::sin(on_path.yaw), std::cos(on_path.yaw));
+  const double cross_track = (rear_xy - Eigen::Vector2d(on_path.x, on_path.y)).dot(left);
+  const double kappa = path_.curvature_at(progress_ + speed * p_.preview_s);
+  const double a_lat = speed * speed * kappa;
   const double K = vehicle_.mass / wheelbase *
                    (vehicle_.lr / (2 * vehicle_.cornering_stiffness_front) -
                     vehicle_.lf / (2 * vehicle_.cornering_stiffness_rear));
-  const double feed_forward = std::atan(wheelbase * kappa) + K * speed * speed * kappa;
+  const double rear_slip = vehicle_.mass * vehicle_.lf * a_lat / (2 * vehicle_.cornering_stiffness_rear * wheelbase);
+  const double feed_forward = std::atan(wheelbase * kappa) + K * a_lat;
+  const double heading_error = std::remainder(on_path.yaw + rear_slip - rear.yaw, 2 * M_PI);
   const double steer = feed_forward + p_.heading_gain * heading_error -
                        std::atan2(p_.stanley_gain * cross_track, speed + p_.stanley_softening);
 
   // Speed.
   ControllerCommand out;
   out.progress = progress_;
-  const Pose2d on_path = path_.pose_at(progress_);
-  out.cross_track = (rear_xy - Eigen::Vector2d(on_path.x, on_path.y))
-                        .dot(Eigen::Vector2d(-std::sin(on_path.yaw), std::cos(on_path.yaw)));
+  out.cross_track = cross_track;
   if (next_stop_ < stops_.size()) {
     const Wait& stop = stops_[next_stop_];
     const bool at_stop = std::abs(stop.at - progress_) <= p_.stop_tolerance || progress_ > stop.at;
@@ -79,7 +80,12 @@ ControllerCommand PathController::update(int64_t t_ns, const Pose2d& rear, doubl
       if (double(t_ns - stopped_since_ns_) * 1e-9 >= stop.duration_s) ++next_stop_, stopped_since_ns_ = -1;
     }
   }
-  const double v_target = target_speed(progress_, speed);
+  // Aim where the car will be once the drive or brakes have responded, and follow the target's slope
+  // along the path as a feed-forward acceleration; PI takes care of the rest.
+  const double lag_distance = speed * vehicle_.accel_time_constant;
+  const double v_target = target_speed(progress_ + lag_distance, speed);
+  const double v_next = target_speed(progress_ + lag_distance + speed * kFeedForwardHorizon, speed);
+  const double accel_ff = (v_next - v_target) / kFeedForwardHorizon;
   if (v_target < kStandstill && speed < kStandstill) {
     integral_ = 0;
     out.command = {steer, kHoldBrake};
@@ -88,7 +94,7 @@ ControllerCommand PathController::update(int64_t t_ns, const Pose2d& rear, doubl
   }
   const double error = v_target - speed;
   integral_ = std::clamp(integral_ + error * dt, -kIntegralLimit, kIntegralLimit);
-  out.command = {steer, p_.speed_kp * error + p_.speed_ki * integral_};
+  out.command = {steer, accel_ff + p_.speed_kp * error + p_.speed_ki * integral_};
   return out;
 }
 

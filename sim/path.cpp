@@ -66,8 +66,32 @@ double Path::project(const Eigen::Vector2d& q, double from, double to) const {
   return best_s;
 }
 
+// Heading interpolated linearly between segment midpoints: continuous along the path, so its
+// derivative is the curvature of the arcs the polyline approximates.
+static double smooth_heading(const Path& p, double s) {
+  s = p.wrap(s);
+  const size_t n = p.points.size() - 1;  // segments
+  size_t i = std::min(n - 1, size_t(std::upper_bound(p.arc.begin(), p.arc.end(), s) - p.arc.begin()) - 1);
+  auto heading = [&](size_t k) {
+    const Eigen::Vector2d d = p.points[k + 1] - p.points[k];
+    return std::atan2(d.y(), d.x());
+  };
+  auto mid = [&](size_t k) { return 0.5 * (p.arc[k] + p.arc[k + 1]); };
+  const bool after = s >= mid(i);
+  size_t j = after ? i + 1 : i - 1;  // the neighbouring segment on s's side of the midpoint
+  if (after && i + 1 >= n) j = p.closed ? 0 : i;
+  if (!after && i == 0) j = p.closed ? n - 1 : 0;
+  if (j == i) return heading(i);
+  double mj = mid(j);
+  if (p.closed && after && j < i) mj += p.length;
+  if (p.closed && !after && j > i) mj -= p.length;
+  const double u = std::clamp((s - mid(i)) / (mj - mid(i)), 0.0, 1.0);
+  return heading(i) + u * std::remainder(heading(j) - heading(i), 2 * M_PI);
+}
+
 double Path::curvature_at(double s) const {
-  const double a = pose_at(s - kCurvatureWindow).yaw, b = pose_at(s + kCurvatureWindow).yaw;
+  if (points.size() < 3) return 0.0;
+  const double a = smooth_heading(*this, s - kCurvatureWindow), b = smooth_heading(*this, s + kCurvatureWindow);
   const double span = closed ? 2 * kCurvatureWindow : wrap(s + kCurvatureWindow) - wrap(s - kCurvatureWindow);
   return span > 0 ? std::remainder(b - a, 2 * M_PI) / span : 0.0;
 }

@@ -78,7 +78,7 @@ void read_vehicle_overrides(const YamlReader& y, const YAML::Node& n, VehiclePar
 void read_can(const YamlReader& y, const YAML::Node& n, CanConfig& c) {
   y.expect_map(n, "can");
   y.allow_keys(n, {"rate_hz", "wheel_speed_resolution_mps", "wheel_speed_noise_mps", "wheel_speed_scale_error",
-                   "steering_resolution_rad", "steering_noise_rad", "steering_offset_rad", "latency_ms",
+                   "min_detectable_speed_mps", "steering_resolution_rad", "steering_noise_rad", "steering_offset_rad", "latency_ms",
                    "dropout_probability"});
   auto num = [&](const char* key, double& v, double lo, double hi) {
     if (n[key]) v = y.number_in(n[key], key, lo, hi);
@@ -87,11 +87,12 @@ void read_can(const YamlReader& y, const YAML::Node& n, CanConfig& c) {
   num("wheel_speed_resolution_mps", c.wheel_speed_resolution_mps, 0.0, 1.0);
   num("wheel_speed_noise_mps", c.wheel_speed_noise_mps, 0.0, 5.0);
   num("wheel_speed_scale_error", c.wheel_speed_scale_error, -0.2, 0.2);
+  num("min_detectable_speed_mps", c.min_detectable_speed_mps, 0.0, 2.0);
   num("steering_resolution_rad", c.steering_resolution_rad, 0.0, 0.1);
   num("steering_noise_rad", c.steering_noise_rad, 0.0, 0.5);
   num("steering_offset_rad", c.steering_offset_rad, -0.5, 0.5);
   num("dropout_probability", c.dropout_probability, 0.0, 0.99);
-  if (n["latency_ms"]) c.latency_ns = int64_t(y.number_in(n["latency_ms"], "latency_ms", 0.0, 1000.0) * 1e6);
+  if (n["latency_ms"]) c.latency_ns = std::llround(y.number_in(n["latency_ms"], "latency_ms", 0.0, 1000.0) * 1e6);
 }
 
 void read_gps(const YamlReader& y, const YAML::Node& n, GpsConfig& g) {

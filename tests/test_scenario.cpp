@@ -1,0 +1,158 @@
+// The scenario format: a valid scenario loads with its values; every malformed one is rejected with
+// its own message at the right line and column.
+#include <gtest/gtest.h>
+
+#include "sim/scenario.hpp"
+#include "test_support.hpp"
+
+namespace lidarloop {
+namespace {
+
+const char* kValid = R"(world: campus
+duration_s: 30
+seed: 3
+ego:
+  route: {road: loop, lane: right}
+  start_at: 60
+  speed: 8
+  stops: [{at: 164, duration_s: 2}]
+  vehicle: {mass: 2000}
+lidar: {rotation_hz: 20}
+can: {latency_ms: 20, dropout_probability: 0.01}
+gps:
+  bias_sigma_m: 1.5
+  zones: [{kind: outage, centre: [300, 0], radius: 40, from_s: 5, to_s: 25}]
+traffic:
+  - {type: bus, path: {road: loop, lane: right, direction: backward}, start_at: 100, speed: 9}
+  - {type: pedestrian, path: {crosswalk: 1}, speed: 1.4, depart_s: 3}
+  - {type: truck, parked: true, position: [303, 120], yaw_deg: 90}
+localizer: {method: icp-obs}
+loop: closed
+pass: {lateral_rmse_m: 0.1, heading_rmse_deg: 0.3}
+)";
+
+TEST(Scenario, AValidScenarioLoadsWithItsValues) {
+  const Scenario s = parse_scenario(kValid, "valid.yaml");
+  EXPECT_EQ(s.world, "campus");
+  EXPECT_EQ(s.duration_ns(), 30'000'000'000);
+  EXPECT_EQ(s.seed, 3u);
+  EXPECT_EQ(s.ego.route.road, "loop");
+  EXPECT_EQ(s.ego.speed, 8);
+  ASSERT_EQ(s.ego.stops.size(), 1u);
+  EXPECT_EQ(s.ego.vehicle.mass, 2000);
+  EXPECT_EQ(s.lidar.rotation_hz, 20);
+  EXPECT_EQ(s.can.latency_ns, 20'000'000);
+  EXPECT_EQ(s.gps.bias_sigma_m, 1.5);
+  ASSERT_EQ(s.gps.zones.size(), 1u);
+  EXPECT_EQ(s.gps.zones[0].from_ns, 5'000'000'000);
+  ASSERT_EQ(s.traffic.size(), 3u);
+  EXPECT_EQ(s.traffic[0].type, ActorType::bus);
+  EXPECT_TRUE(s.traffic[0].path.backward);
+  EXPECT_EQ(s.traffic[1].path.crosswalk, 1);
+  EXPECT_TRUE(s.traffic[2].parked);
+  EXPECT_EQ(s.localizer_method, "icp-obs");
+  EXPECT_TRUE(s.closed_loop);
+  EXPECT_EQ(s.pass.lateral_rmse_m, 0.1);
+  EXPECT_FALSE(s.pass.longitudinal_rmse_m.has_value());
+}
+
+struct Malformed {
+  const char* name;
+  std::string yaml;
+  const char* location;  // "line:col"
+  const char* message;
+};
+
+// Replaces the first occurrence of `from` in the valid scenario.
+std::string edit(const std::string& from, const std::string& to) {
+  std::string s = kValid;
+  const size_t at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return s.replace(at, from.size(), to);
+}
+
+TEST(Scenario, MalformedScenariosAreRejectedWithTheirOwnMessage) {
+  const std::vector<Malformed> cases = {
+      {"syntax", edit("seed: 3", "seed: [3"), "4:4", "YAML syntax error"},
+      {"unknown top-level key", edit("seed: 3", "sed: 3"), "3:1", "unknown key 'sed'"},
+      {"missing world", edit("world: campus\n", ""), "1:1", "missing key 'world'"},
+      {"negative duration", edit("duration_s: 30", "duration_s: -5"), "2:13", "duration_s = -5 is out of range"},
+      {"duration not a number", edit("duration_s: 30", "duration_s: long"), "2:13", "must be a finite number"},
+      {"unknown ego key", edit("  speed: 8\n", "  sped: 8\n"), "7:3", "unknown key 'sped'"},
+      {"bad lane", edit("{road: loop, lane: right}", "{road: loop, lane: middle}"), "5:29",
+       "lane must be right or left"},
+      {"road and waypoints", edit("{road: loop, lane: right}", "{road: loop, waypoints: [[0, 0], [1, 1]]}"), "5:10",
+       "exactly one of 'road', 'waypoints' or 'crosswalk'"},
+      {"stop without duration", edit("{at: 164, duration_s: 2}", "{at: 164}"), "8:11", "missing key 'duration_s'"},
+      {"vehicle key", edit("{mass: 2000}", "{weight: 2000}"), "9:13", "unknown key 'weight'"},
+      {"lidar out of range", edit("{rotation_hz: 20}", "{rotation_hz: 50}"), "10:22", "rotation_hz = 50 is out of range"},
+      {"can type", edit("latency_ms: 20", "latency_ms: soon"), "11:19", "latency_ms must be a finite number"},
+      {"zone kind", edit("kind: outage", "kind: fog"), "14:18", "zone kind must be outage or multipath"},
+      {"zone times reversed", edit("from_s: 5, to_s: 25", "from_s: 25, to_s: 5"), "14:11", "to_s must be after"},
+      {"unknown actor type", edit("{type: bus,", "{type: tank,"), "16:12", "unknown actor type 'tank'"},
+      {"moving actor without speed", edit("start_at: 100, speed: 9", "start_at: 100"), "16:5", "missing key 'speed'"},
+      {"parked actor with a path", edit("parked: true,", "parked: true, path: {road: loop},"), "18:39",
+       "path makes no sense for a parked actor"},
+      {"unknown method", edit("{method: icp-obs}", "{method: slam}"), "19:21", "unknown localizer method 'slam'"},
+      {"bad loop", edit("loop: closed", "loop: maybe"), "20:7", "loop must be open or closed"},
+      {"unknown threshold", edit("heading_rmse_deg", "heading_rms_deg"), "21:29", "unknown key 'heading_rms_deg'"},
+      {"duplicate key", edit("seed: 3\n", "seed: 3\nseed: 4\n"), "4:1", "key 'seed' appears twice"},
+  };
+  for (const auto& c : cases) {
+    try {
+      parse_scenario(c.yaml, "bad.yaml");
+      ADD_FAILURE() << c.name << ": accepted";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(std::string("bad.yaml:") + c.location + ": ", 0), 0u) << c.name << ": " << msg;
+      EXPECT_NE(msg.find(c.message), std::string::npos) << c.name << ": " << msg;
+    }
+  }
+}
+
+class ScenarioOnCampus : public testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    description_ = new WorldDescription(load_world_description(test::data_path("maps/campus/world.yaml")));
+    world_ = new World(build_world(*description_, test::materials(), test::data_path("assets/actors")));
+  }
+  static void TearDownTestSuite() {
+    delete world_;
+    delete description_;
+  }
+  static void expect_resolve_error(const std::string& yaml, const std::string& location, const std::string& message) {
+    try {
+      resolve_scenario(parse_scenario(yaml, "bad.yaml"), *description_, *world_);
+      ADD_FAILURE() << "accepted: " << message;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind("bad.yaml:" + location + ": ", 0), 0u) << msg;
+      EXPECT_NE(msg.find(message), std::string::npos) << msg;
+    }
+  }
+  static WorldDescription* description_;
+  static World* world_;
+};
+WorldDescription* ScenarioOnCampus::description_ = nullptr;
+World* ScenarioOnCampus::world_ = nullptr;
+
+TEST_F(ScenarioOnCampus, ValidScenarioResolvesOnTheRoads) {
+  const ResolvedScenario r = resolve_scenario(parse_scenario(kValid, "valid.yaml"), *description_, *world_);
+  EXPECT_TRUE(r.ego_route.closed);
+  EXPECT_GT(r.ego_route.length, 1800.0);
+  ASSERT_EQ(r.actors.size(), 3u);
+  EXPECT_EQ(r.actors[1].name, "pedestrian_1");
+}
+
+TEST_F(ScenarioOnCampus, PathsOffTheRoadNetworkAreRejected) {
+  expect_resolve_error(edit("{road: loop, lane: right}", "{waypoints: [[50, 0], [150, 100]]}"), "5:10",
+                       "the ego's route leaves the road network");
+  expect_resolve_error(edit("{road: loop, lane: right}", "{road: highway}"), "5:10", "unknown road 'highway'");
+  expect_resolve_error(edit("{road: loop, lane: right, direction: backward}", "{road: loop, offset: 9}"), "16:23",
+                       "the actor's path leaves the road network");
+  expect_resolve_error(edit("{crosswalk: 1}", "{crosswalk: 40}"), "17:30", "there is no crosswalk 40");
+  expect_resolve_error(edit("position: [303, 120]", "position: [5000, 120]"), "18:5", "outside the world");
+}
+
+}  // namespace
+}  // namespace lidarloop
