@@ -73,8 +73,6 @@ PathSpec read_path(const YamlReader& y, const YAML::Node& n, const char* what) {
   return p;
 }
 
-void read_vehicle_overrides(const YamlReader& y, const YAML::Node& n, VehicleParams& v) { read_vehicle_params(y, n, v); }
-
 void read_can(const YamlReader& y, const YAML::Node& n, CanConfig& c) {
   y.expect_map(n, "can");
   y.allow_keys(n, {"rate_hz", "wheel_speed_resolution_mps", "wheel_speed_noise_mps", "wheel_speed_scale_error",
@@ -142,10 +140,11 @@ void read_rtk(const YamlReader& y, const YAML::Node& n, RtkConfig& r) {
   if (n["heading_sigma_deg"]) r.heading_sigma_rad = y.number_in(n["heading_sigma_deg"], "heading_sigma_deg", 0.0, 10.0) * kDeg;
 }
 
-EgoSpec read_ego(const YamlReader& y, const YAML::Node& n) {
+EgoSpec read_ego(const YamlReader& y, const YAML::Node& n, const VehicleParams& vehicle) {
   y.expect_map(n, "ego");
   y.allow_keys(n, {"route", "start_at", "speed", "initial_speed", "stops", "vehicle", "controller"});
   EgoSpec e;
+  e.vehicle = vehicle;
   e.where = yaml_location(y.file(), n);
   e.route = read_path(y, y.required(n, "route"), "route");
   if (e.route.kind == PathSpec::Kind::crosswalk) y.fail(n["route"], "the ego cannot drive along a crosswalk");
@@ -153,7 +152,7 @@ EgoSpec read_ego(const YamlReader& y, const YAML::Node& n) {
   if (n["speed"]) e.speed = y.number_in(n["speed"], "speed", 0.5, kMaxSpeed);
   if (n["initial_speed"]) e.initial_speed = y.number_in(n["initial_speed"], "initial_speed", 0.0, kMaxSpeed);
   e.stops = read_waits(y, n["stops"], "stops");
-  if (n["vehicle"]) read_vehicle_overrides(y, n["vehicle"], e.vehicle);
+  if (n["vehicle"]) read_vehicle_params(y, n["vehicle"], e.vehicle);
   if (e.speed > e.vehicle.max_speed) y.fail(n["speed"], "speed is above the vehicle's max_speed");
   if (const YAML::Node c = n["controller"]) {
     y.expect_map(c, "controller");
@@ -197,7 +196,7 @@ TrafficSpec read_actor(const YamlReader& y, const YAML::Node& n) {
   return a;
 }
 
-Scenario parse(const YamlReader& y) {
+Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
   const YAML::Node& root = y.root();
   y.expect_map(root, "a scenario");
   y.allow_keys(root, {"world", "duration_s", "seed", "ego", "lidar", "can", "gps", "rtk", "traffic", "localizer",
@@ -207,7 +206,7 @@ Scenario parse(const YamlReader& y) {
   s.world = y.string(y.required(root, "world"), "world");
   s.duration_s = y.number_in(y.required(root, "duration_s"), "duration_s", 0.1, kMaxDuration);
   if (root["seed"]) s.seed = uint64_t(y.integer_in(root["seed"], "seed", 0, (1L << 62)));
-  s.ego = read_ego(y, y.required(root, "ego"));
+  s.ego = read_ego(y, y.required(root, "ego"), vehicle);
   if (root["lidar"]) read_hdl32e_config(y, root["lidar"], s.lidar);
   if (root["can"]) read_can(y, root["can"], s.can);
   if (root["gps"]) read_gps(y, root["gps"], s.gps);
@@ -293,9 +292,11 @@ const std::vector<std::string>& localizer_methods() {
   return methods;
 }
 
-Scenario load_scenario(const std::string& path) { return parse(YamlReader::open(path)); }
-Scenario parse_scenario(const std::string& yaml_text, const std::string& name) {
-  return parse(YamlReader::from_string(yaml_text, name));
+Scenario load_scenario(const std::string& path, const VehicleParams& vehicle) {
+  return parse(YamlReader::open(path), vehicle);
+}
+Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle) {
+  return parse(YamlReader::from_string(yaml_text, name), vehicle);
 }
 
 ResolvedScenario resolve_scenario(const Scenario& s, const WorldDescription& d, const World& world) {

@@ -82,8 +82,9 @@ struct Scenario {
   int64_t duration_ns() const { return static_cast<int64_t>(duration_s * 1e9 + 0.5); }
 };
 
-Scenario load_scenario(const std::string& path);
-Scenario parse_scenario(const std::string& yaml_text, const std::string& name);
+// `vehicle`: the ego's parameters before the scenario's own overrides (assets/vehicle.yaml).
+Scenario load_scenario(const std::string& path, const VehicleParams& vehicle = {});
+Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle = {});
 
 // The localizer methods a scenario may name (the paper's baselines and its proposal).
 const std::vector<std::string>& localizer_methods();

@@ -21,7 +21,7 @@ struct LoadedScenario {
 };
 
 LoadedScenario load(const std::string& path) {
-  Scenario scenario = load_scenario(path);
+  Scenario scenario = load_scenario(path, load_vehicle_params(data_dir() + "/assets/vehicle.yaml"));
   LoadedWorld world = load_world(scenario.world);
   ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
   return {std::move(scenario), std::move(world), std::move(resolved)};

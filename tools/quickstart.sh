@@ -18,12 +18,8 @@ build() {  # build DIR [cmake options...]
 
 if [ "$what" = run ]; then
   build build -DLIDARLOOP_BUILD_TESTS=OFF
-  mkdir -p build/out
-  # Main job: one HDL-32E scan on the campus, driving at 10 m/s behind a truck, past a bus parked on
-  # the other side of the road, while a pedestrian walks onto the sidewalk.
-  build/tools/lidarloop scan --world campus --pose 240,-2.25,0 --speed 10 \
-    --actor bus,252,3.0,180 --actor truck,262,-2.25,0,8 --actor pedestrian,236,-6.5,90,1.4 \
-    --out build/out/scan.ply --png build/out/scan.png
+  # Main job: the default scenario, a minute around the campus with traffic (no localizer yet).
+  build/tools/lidarloop simulate scenarios/campus_traffic.yaml --out build/out/campus_traffic
   exit 0
 fi
 
