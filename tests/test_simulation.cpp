@@ -87,7 +87,9 @@ traffic:
       EXPECT_GT(on_bus, 500);  // the bus is in the scan where it should be
       EXPECT_LT(curb, 10);     // and the right curb beside the ego is hidden
     }
-    if (far) EXPECT_GT(curb, 40);  // without the bus the curb face is plain to see
+    if (far) {
+      EXPECT_GT(curb, 40);  // without the bus the curb face is plain to see
+    }
   }
 }
 
