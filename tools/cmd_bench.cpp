@@ -110,16 +110,20 @@ static int bench_lidar(const Args& args) {
 static int run_bench(const Args& args) {
   const std::string what = args.positional().at(0);
   if (what == "lidar") return bench_lidar(args);
-  throw InputError("lidarloop bench: unknown benchmark '" + what + "' (available: lidar)");
+  if (what == "map") return run_bench_map(args);
+  throw InputError("lidarloop bench: unknown benchmark '" + what + "' (available: lidar, map)");
 }
 
 Command bench_command() {
   return {{"bench",
-           "lidarloop bench lidar [--world W] [--threads N] [--scans N]",
-           "Measure speed and print JSON. lidar: HDL-32E scans against bare Embree rtcIntersect1 on the same rays.",
+           "lidarloop bench lidar|map [--world W] [--threads N] [--scans N] [--cache-tiles N] [--step M]",
+           "Measure and print JSON. lidar: HDL-32E scans against bare Embree rtcIntersect1 on the same rays.\n"
+           "map: a localizer's map queries along every road of a built map, and the peak resident set.",
            {{"world", "NAME|FILE", "world (default campus)"},
             {"threads", "N", "worker threads (default: all cores)"},
-            {"scans", "N", "timed scans after two warm-up scans (default 20)"}},
+            {"scans", "N", "lidar: timed scans after two warm-up scans (default 20)"},
+            {"cache-tiles", "N", "map: intensity tiles kept in memory (default 16)"},
+            {"step", "M", "map: metres driven between queries (default 12)"}},
            1, 1},
           run_bench};
 }

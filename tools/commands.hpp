@@ -16,6 +16,8 @@ Command scan_command();
 Command bench_command();
 Command validate_command();
 Command simulate_command();
+Command map_command();
+int run_bench_map(const Args& args);
 
 // --threads N: 0 means all cores. Returns the effective count.
 int thread_count(const Args& args);

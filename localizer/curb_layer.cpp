@@ -1,0 +1,78 @@
+#include "localizer/curb_layer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <nanoflann.hpp>
+
+namespace lidarloop {
+
+// nanoflann's dataset interface over the densified points.
+struct PointsAdaptor {
+  const std::vector<Eigen::Vector2d>* points;
+  size_t kdtree_get_point_count() const { return points->size(); }
+  double kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][int(dim)]; }
+  template <class BBox> bool kdtree_get_bbox(BBox&) const { return false; }
+};
+
+struct CurbLayer::Index {
+  PointsAdaptor adaptor;
+  nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor, 2> tree;
+  explicit Index(const std::vector<Eigen::Vector2d>* points)
+      : adaptor{points}, tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+    tree.buildIndex();
+  }
+};
+
+CurbLayer::CurbLayer(const CurbMap& map, double spacing) : map_(map) {
+  for (const auto& line : map_.curbs)
+    for (size_t i = 1; i < line.size(); ++i) {
+      const Eigen::Vector2d d = line[i] - line[i - 1];
+      const int steps = std::max(1, int(std::ceil(d.norm() / spacing)));
+      for (int k = 0; k < steps; ++k) points_.push_back(line[i - 1] + d * (double(k) / steps));
+      if (i + 1 == line.size()) points_.push_back(line[i]);
+    }
+  index_ = std::make_unique<Index>(&points_);
+}
+
+CurbLayer CurbLayer::load(const std::string& geojson_path, double spacing) {
+  return CurbLayer(read_curb_map(geojson_path), spacing);
+}
+
+CurbLayer::~CurbLayer() = default;
+// The index reads the points through a pointer to the member vector: re-aim it after a move.
+CurbLayer::CurbLayer(CurbLayer&& other) noexcept
+    : map_(std::move(other.map_)), points_(std::move(other.points_)), index_(std::move(other.index_)) {
+  if (index_) index_->adaptor.points = &points_;
+}
+CurbLayer& CurbLayer::operator=(CurbLayer&& other) noexcept {
+  map_ = std::move(other.map_);
+  points_ = std::move(other.points_);
+  index_ = std::move(other.index_);
+  if (index_) index_->adaptor.points = &points_;
+  return *this;
+}
+
+std::vector<Eigen::Vector2d> CurbLayer::window(const Eigen::Vector2d& centre, double half_extent) const {
+  std::vector<std::pair<uint32_t, double>> matches;
+  nanoflann::SearchParams params;
+  params.sorted = false;
+  const double radius = half_extent * std::sqrt(2.0);
+  index_->tree.radiusSearch(centre.data(), radius * radius, matches, params);
+  std::sort(matches.begin(), matches.end());  // deterministic order: by point index
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& [i, d2] : matches) {
+    const Eigen::Vector2d& p = points_[i];
+    if (std::abs(p.x() - centre.x()) <= half_extent && std::abs(p.y() - centre.y()) <= half_extent) out.push_back(p);
+  }
+  return out;
+}
+
+double CurbLayer::distance(const Eigen::Vector2d& p) const {
+  uint32_t index = 0;
+  double d2 = 0;
+  index_->tree.knnSearch(p.data(), 1, &index, &d2);
+  return std::sqrt(d2);
+}
+
+}  // namespace lidarloop

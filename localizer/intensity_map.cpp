@@ -1,0 +1,506 @@
+#include "localizer/intensity_map.hpp"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+#include "common/input_error.hpp"
+#include "common/yaml_reader.hpp"
+
+namespace lidarloop {
+namespace {
+
+namespace fs = std::filesystem;
+
+// map.yaml
+constexpr const char* kHeaderFile = "map.yaml";
+constexpr const char* kTilesDir = "tiles";
+constexpr const char* kFormatName = "lidarloop-intensity-map";
+constexpr const char* kProjection = "transverse_mercator";
+constexpr long kFormatVersion = 1;
+constexpr long kMinTileCells = 8;
+constexpr long kMaxTileCells = 4096;
+constexpr double kMaxLatitudeDeg = 90;
+constexpr double kMaxLongitudeDeg = 180;
+// tile_size_m is redundant (resolution_m * tile_cells); it is written for people, and checked on reading
+// only up to the rounding of the printed decimal.
+constexpr double kTileSizeRelativeTolerance = 1e-9;
+
+// Tile files: little-endian; header, cells, CRC-32 of everything before it.
+constexpr std::array<char, 4> kTileMagic = {'L', 'L', 'I', 'T'};
+constexpr uint32_t kTileVersion = 1;
+constexpr size_t kTileHeaderBytes = 4 + 4 + 4 + 4 + 4;  // magic, version, tile_x, tile_y, tile_cells
+constexpr size_t kCellBytes = 4 + 4 + 4;               // count, mean, m2
+constexpr size_t kCrcBytes = 4;
+constexpr const char* kTileExtension = ".tile";
+constexpr const char* kTempSuffix = ".tmp";
+
+// Points exactly on a cell boundary (x = k * resolution, e.g. 0.6 at 0.2 m) must land in the cell that
+// starts there although x / resolution may round to just below k; a few ulps decide, far below any
+// physical distance.
+constexpr double kBoundarySnapUlps = 64;
+
+// CRC-32, IEEE 802.3 (reflected polynomial 0xEDB88320; zlib, PNG, gzip), table-driven.
+constexpr uint32_t kCrcPolynomial = 0xEDB88320u;
+constexpr uint32_t kCrcInitial = 0xFFFFFFFFu;
+constexpr uint32_t kCrcFinalXor = 0xFFFFFFFFu;
+constexpr size_t kBitsPerByte = 8;
+constexpr size_t kByteValues = 256;
+constexpr uint32_t kLowByte = 0xFFu;
+
+constexpr std::array<uint32_t, kByteValues> make_crc_table() {
+  std::array<uint32_t, kByteValues> table{};
+  for (uint32_t n = 0; n < kByteValues; ++n) {
+    uint32_t c = n;
+    for (size_t bit = 0; bit < kBitsPerByte; ++bit) c = (c & 1u) ? kCrcPolynomial ^ (c >> 1) : c >> 1;
+    table[n] = c;
+  }
+  return table;
+}
+constexpr std::array<uint32_t, kByteValues> kCrcTable = make_crc_table();
+
+uint32_t crc32(const std::string& bytes, size_t length) {
+  uint32_t c = kCrcInitial;
+  for (size_t i = 0; i < length; ++i)
+    c = kCrcTable[(c ^ static_cast<unsigned char>(bytes[i])) & kLowByte] ^ (c >> kBitsPerByte);
+  return c ^ kCrcFinalXor;
+}
+
+// Explicit little-endian bytes, so files are the same on any host.
+void put_u32(std::string& out, uint32_t v) {
+  for (size_t i = 0; i < sizeof v; ++i) out.push_back(static_cast<char>((v >> (kBitsPerByte * i)) & kLowByte));
+}
+void put_i32(std::string& out, int32_t v) { put_u32(out, static_cast<uint32_t>(v)); }
+void put_f32(std::string& out, float v) { put_u32(out, std::bit_cast<uint32_t>(v)); }
+
+uint32_t get_u32(const std::string& in, size_t offset) {
+  uint32_t v = 0;
+  for (size_t i = 0; i < sizeof v; ++i)
+    v |= uint32_t(static_cast<unsigned char>(in[offset + i])) << (kBitsPerByte * i);
+  return v;
+}
+int32_t get_i32(const std::string& in, size_t offset) { return static_cast<int32_t>(get_u32(in, offset)); }
+float get_f32(const std::string& in, size_t offset) { return std::bit_cast<float>(get_u32(in, offset)); }
+
+size_t tile_file_bytes(size_t tile_cells) { return kTileHeaderBytes + tile_cells * tile_cells * kCellBytes + kCrcBytes; }
+
+// Built by appending: GCC 12 warns falsely (-Wrestrict, bug 105651) on some `"literal" + string` chains.
+std::string tile_file_name(int tx, int ty) {
+  std::string name = std::to_string(tx);
+  name.append("_").append(std::to_string(ty)).append(kTileExtension);
+  return name;
+}
+
+std::string tile_name(int tx, int ty) {
+  std::string name = "(";
+  name.append(std::to_string(tx)).append(", ").append(std::to_string(ty)).append(")");
+  return name;
+}
+
+// Shortest decimal that reads back to the same double: 0.2 stays "0.2" for people, lat/lon stay exact.
+std::string shortest(double v) {
+  std::array<char, 64> buf{};
+  const auto result = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  return std::string(buf.data(), result.ptr);
+}
+
+void check_geometry(const IntensityMapHeader& h, const char* who) {
+  if (!(std::isfinite(h.resolution_m) && h.resolution_m > 0))
+    throw std::invalid_argument(std::string(who) + ": resolution_m must be a positive number");
+  if (h.tile_cells < kMinTileCells || h.tile_cells > kMaxTileCells)
+    throw std::invalid_argument(std::string(who) + ": tile_cells = " + std::to_string(h.tile_cells) +
+                                " is out of range [" + std::to_string(kMinTileCells) + ", " +
+                                std::to_string(kMaxTileCells) + "]");
+}
+
+// Index of the global cell containing `coord`, floor division (so -0.1 m is cell -1), if the tile index
+// it falls in fits an int.
+std::optional<int64_t> global_cell(double coord, double resolution, int tile_cells) {
+  double q = coord / resolution;
+  if (!std::isfinite(q)) return std::nullopt;
+  const double nearest = std::round(q);
+  if (std::fabs(q - nearest) <= kBoundarySnapUlps * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(q)))
+    q = nearest;
+  const double cell = std::floor(q);
+  // Both bounds are exact in double (|value| < 2^44 for tile_cells <= 4096).
+  const double lo = double(INT_MIN) * tile_cells;
+  const double hi = (double(INT_MAX) + 1) * tile_cells - 1;
+  if (cell < lo || cell > hi) return std::nullopt;
+  return static_cast<int64_t>(cell);
+}
+
+std::optional<CellIndex> try_cell_index(const IntensityMapHeader& h, const Eigen::Vector2d& xy) {
+  const auto gx = global_cell(xy.x(), h.resolution_m, h.tile_cells);
+  const auto gy = global_cell(xy.y(), h.resolution_m, h.tile_cells);
+  if (!gx || !gy) return std::nullopt;
+  const int64_t n = h.tile_cells;
+  // Floor division: C++ '/' truncates towards zero, which would fold tiles -1 and 0 together.
+  auto floor_div = [](int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); };
+  const int64_t tx = floor_div(*gx, n), ty = floor_div(*gy, n);
+  return CellIndex{static_cast<int>(tx), static_cast<int>(ty), static_cast<int>(*gx - tx * n),
+                   static_cast<int>(*gy - ty * n)};
+}
+
+size_t flat_index(const CellIndex& c, int tile_cells) { return size_t(c.cell_y) * size_t(tile_cells) + size_t(c.cell_x); }
+
+std::vector<IntensityMoments>& tile_or_new(std::map<std::pair<int, int>, std::vector<IntensityMoments>>& tiles,
+                                           IntensityMapHeader& header, std::pair<int, int> key) {
+  auto [it, inserted] = tiles.try_emplace(key);
+  if (inserted) {
+    it->second.resize(size_t(header.tile_cells) * size_t(header.tile_cells));
+    // Kept sorted so that the header written by save() lists tiles in a stable order.
+    header.tiles.insert(std::lower_bound(header.tiles.begin(), header.tiles.end(), key), key);
+  }
+  return it->second;
+}
+
+std::string encode_tile(int tx, int ty, int tile_cells, const std::vector<IntensityMoments>& cells) {
+  std::string out;
+  out.reserve(tile_file_bytes(size_t(tile_cells)));
+  out.append(kTileMagic.data(), kTileMagic.size());
+  put_u32(out, kTileVersion);
+  put_i32(out, tx);
+  put_i32(out, ty);
+  put_u32(out, uint32_t(tile_cells));
+  for (const IntensityMoments& m : cells) {  // row-major: y rows, x columns
+    const IntensityCell c = m.to_cell();
+    put_u32(out, c.count);
+    put_f32(out, c.mean);
+    put_f32(out, c.m2);
+  }
+  put_u32(out, crc32(out, out.size()));
+  return out;
+}
+
+// Writes to a temporary name and renames it over `path`, so a reader never sees half a file.
+void write_file_atomically(const fs::path& path, const std::string& bytes) {
+  const fs::path temp = path.string() + kTempSuffix;
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    out.close();
+    if (!out) throw InputError(temp.string() + ": cannot write file");
+  }
+  std::error_code ec;
+  fs::rename(temp, path, ec);
+  if (ec) throw InputError(path.string() + ": cannot write file: " + ec.message());
+}
+
+// Plain scalars for people; yaml-cpp quotes the ones that would read back as something else ("null", "").
+std::string header_yaml(const IntensityMapHeader& h) {
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  out << YAML::Key << "format" << YAML::Value << kFormatName;
+  out << YAML::Key << "version" << YAML::Value << kFormatVersion;
+  out << YAML::Key << "world" << YAML::Value << h.world;
+  out << YAML::Key << "world_hash" << YAML::Value << h.world_hash;
+  out << YAML::Key << "origin" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "lat" << YAML::Value << shortest(h.origin.lat_deg);
+  out << YAML::Key << "lon" << YAML::Value << shortest(h.origin.lon_deg);
+  out << YAML::Key << "alt" << YAML::Value << shortest(h.origin.alt_m);
+  out << YAML::EndMap;
+  out << YAML::Key << "projection" << YAML::Value << kProjection;
+  out << YAML::Key << "resolution_m" << YAML::Value << shortest(h.resolution_m);
+  out << YAML::Key << "tile_cells" << YAML::Value << h.tile_cells;
+  out << YAML::Key << "tile_size_m" << YAML::Value << shortest(h.tile_size_m());
+  out << YAML::Key << "build" << YAML::Value << YAML::BeginMap;
+  for (const auto& [key, value] : h.build)
+    out << YAML::Key << key << YAML::Value << value;
+  out << YAML::EndMap;
+  out << YAML::Key << "tiles" << YAML::Value << YAML::BeginSeq;
+  for (const auto& [tx, ty] : h.tiles) out << YAML::Flow << YAML::BeginSeq << tx << ty << YAML::EndSeq;
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  if (!out.good()) throw std::logic_error("intensity map header: YAML emitter error: " + out.GetLastError());
+  return std::string(out.c_str()) + "\n";
+}
+
+// Reads and checks one tile file against its name and the header; every problem names the file.
+std::vector<IntensityCell> load_tile(const fs::path& path, const IntensityMapHeader& h, int tx, int ty) {
+  const std::string file = path.string();
+  std::error_code ec;
+  if (!fs::exists(path, ec))
+    throw InputError(file + ": tile file is missing (map.yaml lists tile " + tile_name(tx, ty) + ")");
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in.is_open()) throw InputError(file + ": cannot open tile file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    bytes = text.str();
+  }
+  const size_t expected = tile_file_bytes(size_t(h.tile_cells));
+  auto truncated = [&] {
+    return InputError(file + ": truncated tile file (" + std::to_string(bytes.size()) + " bytes, a tile of " +
+                      std::to_string(h.tile_cells) + "x" + std::to_string(h.tile_cells) + " cells has " +
+                      std::to_string(expected) + ")");
+  };
+  if (bytes.size() < kTileHeaderBytes) throw truncated();
+  if (!std::equal(kTileMagic.begin(), kTileMagic.end(), bytes.begin()))
+    throw InputError(file + ": not an intensity map tile (bad magic, expected 'LLIT')");
+  size_t at = kTileMagic.size();
+  const uint32_t version = get_u32(bytes, at);
+  at += 4;
+  if (version != kTileVersion)
+    throw InputError(file + ": unsupported tile version " + std::to_string(version) + " (expected " +
+                     std::to_string(kTileVersion) + ")");
+  const int32_t file_tx = get_i32(bytes, at);
+  at += 4;
+  const int32_t file_ty = get_i32(bytes, at);
+  at += 4;
+  const uint32_t file_cells = get_u32(bytes, at);
+  at += 4;
+  if (file_cells != uint32_t(h.tile_cells))
+    throw InputError(file + ": tile has tile_cells = " + std::to_string(file_cells) + " but map.yaml says " +
+                     std::to_string(h.tile_cells));
+  if (bytes.size() < expected) throw truncated();
+  if (bytes.size() > expected)
+    throw InputError(file + ": tile file has " + std::to_string(bytes.size() - expected) +
+                     " unexpected bytes after its checksum");
+  const uint32_t stored_crc = get_u32(bytes, expected - kCrcBytes);
+  const uint32_t computed_crc = crc32(bytes, expected - kCrcBytes);
+  if (stored_crc != computed_crc) {
+    std::ostringstream msg;
+    msg << file << ": checksum mismatch (CRC-32 stored 0x" << std::hex << stored_crc << ", computed 0x"
+        << computed_crc << "): the tile file is corrupt";
+    throw InputError(msg.str());
+  }
+  if (file_tx != tx || file_ty != ty)
+    throw InputError(file + ": file holds tile " + tile_name(file_tx, file_ty) + " but its name says " +
+                     tile_name(tx, ty));
+  std::vector<IntensityCell> cells(size_t(h.tile_cells) * size_t(h.tile_cells));
+  for (size_t i = 0; i < cells.size(); ++i, at += kCellBytes) {
+    IntensityCell& c = cells[i];
+    c.count = get_u32(bytes, at);
+    c.mean = get_f32(bytes, at + 4);
+    c.m2 = get_f32(bytes, at + 8);
+    // A checksum only proves the bytes are the ones written; a hand-made file can still hold nonsense.
+    if (!std::isfinite(c.mean) || !std::isfinite(c.m2) || c.m2 < 0)
+      throw InputError(file + ": cell (" + std::to_string(i % size_t(h.tile_cells)) + ", " +
+                       std::to_string(i / size_t(h.tile_cells)) + ") holds invalid statistics");
+  }
+  return cells;
+}
+
+}  // namespace
+
+// Eq. 8 of the paper updates the count, the mean and the sample variance S_sigma (n - 1 denominator)
+// directly. Welford's form below is the same recursion on m2 = sum of squared deviations
+// (S_sigma = m2 / (n - 1)), without the (n - 1) / n factor that is undefined for the first point.
+void IntensityMoments::add(double value) {
+  if (count == std::numeric_limits<uint32_t>::max())
+    throw std::overflow_error("intensity cell: more points than a uint32 count holds");
+  ++count;
+  const double delta = value - mean;
+  mean += delta / double(count);
+  m2 += delta * (value - mean);
+}
+
+// Chan, Golub & LeVeque's pairwise combination: merging two partial maps is exact, not an average of
+// averages.
+void IntensityMoments::merge(const IntensityMoments& other) {
+  const IntensityMoments b = other;  // `other` may be *this
+  if (b.count == 0) return;
+  if (count == 0) {
+    *this = b;
+    return;
+  }
+  const uint64_t n = uint64_t(count) + uint64_t(b.count);
+  if (n > std::numeric_limits<uint32_t>::max())
+    throw std::overflow_error("intensity cell: more points than a uint32 count holds");
+  const double na = count, nb = b.count, total = double(n);
+  const double delta = b.mean - mean;
+  mean += delta * nb / total;
+  m2 += b.m2 + delta * delta * na * nb / total;
+  count = uint32_t(n);
+}
+
+// Computed in double, stored in float: the float rounding happens once per update here. Builders
+// accumulate IntensityMoments instead, so a map is rounded once.
+void IntensityCell::add(double value) {
+  IntensityMoments m = IntensityMoments::from_cell(*this);
+  m.add(value);
+  *this = m.to_cell();
+}
+
+void IntensityCell::merge(const IntensityCell& other) {
+  IntensityMoments m = IntensityMoments::from_cell(*this);
+  m.merge(IntensityMoments::from_cell(other));
+  *this = m.to_cell();
+}
+
+CellIndex cell_index(const IntensityMapHeader& header, const Eigen::Vector2d& xy) {
+  check_geometry(header, "cell_index");
+  const auto c = try_cell_index(header, xy);
+  if (!c) {
+    std::ostringstream msg;
+    msg << "cell_index: point (" << xy.x() << ", " << xy.y() << ") has no tile index";
+    throw std::out_of_range(msg.str());
+  }
+  return *c;
+}
+
+IntensityMapBuilder::IntensityMapBuilder(IntensityMapHeader header) : header_(std::move(header)) {
+  check_geometry(header_, "IntensityMapBuilder");
+  header_.tiles.clear();  // the tile list is what this builder holds, kept by tile_or_new
+}
+
+void IntensityMapBuilder::add(const Eigen::Vector2d& xy, double intensity) {
+  // Organised clouds mark "no return" with NaN: not a measurement, so not part of the map.
+  if (!xy.allFinite() || !std::isfinite(intensity)) return;
+  const CellIndex c = cell_index(header_, xy);
+  tile_or_new(tiles_, header_, {c.tile_x, c.tile_y})[flat_index(c, header_.tile_cells)].add(intensity);
+}
+
+void IntensityMapBuilder::merge(const IntensityMapBuilder& other) {
+  const IntensityMapHeader& o = other.header_;
+  if (o.resolution_m != header_.resolution_m || o.tile_cells != header_.tile_cells ||
+      o.origin.lat_deg != header_.origin.lat_deg || o.origin.lon_deg != header_.origin.lon_deg)
+    throw std::invalid_argument("IntensityMapBuilder::merge: maps differ in origin, resolution or tile size");
+  for (const auto& [key, cells] : other.tiles_) {
+    std::vector<IntensityMoments>& mine = tile_or_new(tiles_, header_, key);
+    for (size_t i = 0; i < mine.size(); ++i) mine[i].merge(cells[i]);
+  }
+}
+
+std::optional<IntensityCell> IntensityMapBuilder::cell(const Eigen::Vector2d& xy) const {
+  const auto c = try_cell_index(header_, xy);
+  if (!c) return std::nullopt;
+  const auto it = tiles_.find({c->tile_x, c->tile_y});
+  if (it == tiles_.end()) return std::nullopt;
+  const IntensityMoments& m = it->second[flat_index(*c, header_.tile_cells)];
+  if (m.count == 0) return std::nullopt;
+  return m.to_cell();
+}
+
+void IntensityMapBuilder::save(const std::string& dir) const {
+  const fs::path root(dir), tiles_dir = root / kTilesDir;
+  std::error_code ec;
+  fs::create_directories(tiles_dir, ec);
+  if (ec) throw InputError(tiles_dir.string() + ": cannot create map directory: " + ec.message());
+  // Without a header a half-replaced map fails loudly instead of mixing old and new tiles.
+  fs::remove(root / kHeaderFile, ec);
+  if (ec) throw InputError((root / kHeaderFile).string() + ": cannot remove the previous map header: " + ec.message());
+  // Stale tiles of a previous map would otherwise sit unlisted next to the new ones. Only our own
+  // files go: anything else a user keeps there is left alone.
+  std::vector<fs::path> stale;
+  for (fs::directory_iterator it(tiles_dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.ends_with(kTileExtension) || name.ends_with(std::string(kTileExtension) + kTempSuffix))
+      stale.push_back(it->path());
+  }
+  if (ec) throw InputError(tiles_dir.string() + ": cannot list directory: " + ec.message());
+  for (const fs::path& path : stale)
+    if (fs::remove(path, ec); ec) throw InputError(path.string() + ": cannot remove stale tile: " + ec.message());
+  for (const auto& [key, cells] : tiles_)
+    write_file_atomically(tiles_dir / tile_file_name(key.first, key.second),
+                          encode_tile(key.first, key.second, header_.tile_cells, cells));
+  write_file_atomically(root / kHeaderFile, header_yaml(header_));  // last: the map exists once it is whole
+}
+
+IntensityMapHeader read_intensity_map_header(const std::string& dir) {
+  const YamlReader yaml = YamlReader::open((fs::path(dir) / kHeaderFile).string());
+  const YAML::Node& root = yaml.root();
+  yaml.expect_map(root, "intensity map header");
+  yaml.allow_keys(root, {"format", "version", "world", "world_hash", "origin", "projection", "resolution_m",
+                         "tile_cells", "tile_size_m", "build", "tiles"});
+  IntensityMapHeader h;
+
+  const YAML::Node format = yaml.required(root, "format");
+  if (yaml.string(format, "format") != kFormatName)
+    yaml.fail(format, "format is '" + format.Scalar() + "', expected '" + kFormatName + "'");
+  const YAML::Node version = yaml.required(root, "version");
+  const long v = yaml.integer_in(version, "version", LONG_MIN, LONG_MAX);
+  if (v != kFormatVersion)
+    yaml.fail(version, "unsupported version " + std::to_string(v) + " (expected " + std::to_string(kFormatVersion) + ")");
+
+  h.world = yaml.string(yaml.required(root, "world"), "world");
+  h.world_hash = yaml.string(yaml.required(root, "world_hash"), "world_hash");
+
+  const YAML::Node origin = yaml.required(root, "origin");
+  yaml.expect_map(origin, "origin");
+  yaml.allow_keys(origin, {"lat", "lon", "alt"});
+  h.origin.lat_deg = yaml.number_in(yaml.required(origin, "lat"), "origin.lat", -kMaxLatitudeDeg, kMaxLatitudeDeg);
+  h.origin.lon_deg = yaml.number_in(yaml.required(origin, "lon"), "origin.lon", -kMaxLongitudeDeg, kMaxLongitudeDeg);
+  h.origin.alt_m = yaml.number(yaml.required(origin, "alt"), "origin.alt");
+
+  const YAML::Node projection = yaml.required(root, "projection");
+  if (yaml.string(projection, "projection") != kProjection)
+    yaml.fail(projection, "projection '" + projection.Scalar() + "' is not supported (expected '" + kProjection + "')");
+
+  const YAML::Node resolution = yaml.required(root, "resolution_m");
+  h.resolution_m = yaml.number(resolution, "resolution_m");
+  if (h.resolution_m <= 0) yaml.fail(resolution, "resolution_m = " + resolution.Scalar() + " must be > 0");
+  h.tile_cells = int(yaml.integer_in(yaml.required(root, "tile_cells"), "tile_cells", kMinTileCells, kMaxTileCells));
+  const YAML::Node tile_size = yaml.required(root, "tile_size_m");
+  const double size = yaml.number(tile_size, "tile_size_m");
+  if (std::fabs(size - h.tile_size_m()) > kTileSizeRelativeTolerance * h.tile_size_m())
+    yaml.fail(tile_size, "tile_size_m = " + tile_size.Scalar() + " does not match resolution_m * tile_cells = " +
+                             shortest(h.tile_size_m()));
+
+  const YAML::Node build = yaml.required(root, "build");
+  yaml.expect_map(build, "build");
+  for (const auto& entry : build) h.build[yaml.string(entry.first, "build key")] = yaml.string(entry.second, "build value");
+
+  const YAML::Node tiles = yaml.required(root, "tiles");
+  yaml.expect_sequence(tiles, "tiles");
+  std::set<std::pair<int, int>> seen;
+  for (const YAML::Node& t : tiles) {
+    if (!t.IsSequence() || t.size() != 2) yaml.fail(t, "a tile must be [ix, iy]");
+    const std::pair<int, int> key{int(yaml.integer_in(t[0], "tile ix", INT_MIN, INT_MAX)),
+                                  int(yaml.integer_in(t[1], "tile iy", INT_MIN, INT_MAX))};
+    if (!seen.insert(key).second) yaml.fail(t, "tile " + tile_name(key.first, key.second) + " is listed twice");
+    h.tiles.push_back(key);
+  }
+  std::sort(h.tiles.begin(), h.tiles.end());
+  return h;
+}
+
+IntensityMap::IntensityMap(const std::string& dir, size_t max_cached_tiles)
+    : dir_(dir), header_(read_intensity_map_header(dir)), max_cached_(max_cached_tiles) {
+  if (max_cached_ == 0) throw std::invalid_argument("IntensityMap: max_cached_tiles must be at least 1");
+  for (const auto& key : header_.tiles) present_[key] = true;
+}
+
+std::optional<IntensityCell> IntensityMap::cell(const Eigen::Vector2d& xy) {
+  const auto c = try_cell_index(header_, xy);
+  if (!c) return std::nullopt;
+  const std::vector<IntensityCell>* cells = tile(c->tile_x, c->tile_y);
+  if (cells == nullptr) return std::nullopt;
+  const IntensityCell& value = (*cells)[flat_index(*c, header_.tile_cells)];
+  if (value.count == 0) return std::nullopt;
+  return value;
+}
+
+// The returned pointer is valid until the next call (which may evict it).
+const std::vector<IntensityCell>* IntensityMap::tile(int tx, int ty) {
+  const std::pair<int, int> key{tx, ty};
+  if (present_.find(key) == present_.end()) return nullptr;  // not in the map: no data there
+  if (auto hit = cache_.find(key); hit != cache_.end()) {
+    lru_.splice(lru_.begin(), lru_, hit->second.second);
+    return &hit->second.first;
+  }
+  // Loaded before touching the cache, so a bad tile leaves the cache as it was.
+  std::vector<IntensityCell> cells = load_tile(fs::path(dir_) / kTilesDir / tile_file_name(tx, ty), header_, tx, ty);
+  ++loads_;
+  if (cache_.size() >= max_cached_) {
+    cache_.erase(lru_.back());
+    lru_.pop_back();
+  }
+  lru_.push_front(key);
+  const auto inserted = cache_.emplace(key, std::make_pair(std::move(cells), lru_.begin())).first;
+  return &inserted->second.first;
+}
+
+}  // namespace lidarloop

@@ -1,0 +1,110 @@
+#pragma once
+// The intensity layer of the HD map (the paper's Fig. 9b, section 2.2.2): a grid over the local frame
+// whose cells hold the count, mean and variance of the LiDAR intensities of the ground that fell in
+// them, kept with the numerically stable running update of Eq. 8 (Welford's algorithm).
+//
+// On disk: a folder with `map.yaml` (origin, resolution, projection, tile size, world name and hash,
+// build parameters, and the list of tiles) and `tiles/<ix>_<iy>.tile` files, each a fixed-size binary
+// block of tile_cells x tile_cells cells with a checksum. Readers load tiles lazily and keep at most a
+// bounded number in memory, so memory does not grow with the map.
+#include <cstdint>
+#include <list>
+#include <map>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/geodetic.hpp"
+
+namespace lidarloop {
+
+struct IntensityCell {
+  uint32_t count = 0;
+  float mean = 0;
+  float m2 = 0;  // sum of squared deviations from the mean (Welford); variance = m2 / count
+
+  void add(double value);                       // Eq. 8
+  void merge(const IntensityCell& other);       // Chan et al.'s pairwise combination
+  double variance() const { return count > 0 ? double(m2) / double(count) : 0.0; }
+};
+
+// The same statistics in double precision: what a builder accumulates, so that a cell hit by many
+// points is rounded to float once (when stored) instead of at every update. IntensityCell::add and
+// ::merge run through these, so Eq. 8 and Chan's formula exist once.
+struct IntensityMoments {
+  uint32_t count = 0;
+  double mean = 0;
+  double m2 = 0;
+
+  void add(double value);                       // Eq. 8 (Welford form)
+  void merge(const IntensityMoments& other);    // Chan et al.
+  double variance() const { return count > 0 ? m2 / double(count) : 0.0; }
+  IntensityCell to_cell() const { return {count, float(mean), float(m2)}; }
+  static IntensityMoments from_cell(const IntensityCell& c) { return {c.count, c.mean, c.m2}; }
+};
+
+struct IntensityMapHeader {
+  std::string world;               // world name
+  std::string world_hash;          // hex digest of what the map was built from
+  Geodetic origin;                 // of the local frame (transverse Mercator, scale 1 on its meridian)
+  double resolution_m = 0.2;       // cell size
+  int tile_cells = 320;            // cells per tile side (64 m at 0.2 m)
+  std::map<std::string, std::string> build;  // free-form build parameters, for people and cache keys
+  std::vector<std::pair<int, int>> tiles;    // tile indices present on disk
+
+  double tile_size_m() const { return resolution_m * tile_cells; }
+};
+
+// Tile index and cell-within-tile of a local point.
+struct CellIndex {
+  int tile_x, tile_y;
+  int cell_x, cell_y;
+};
+CellIndex cell_index(const IntensityMapHeader& header, const Eigen::Vector2d& xy);
+
+// Accumulates a map in memory (a mapping drive), then writes it.
+class IntensityMapBuilder {
+ public:
+  explicit IntensityMapBuilder(IntensityMapHeader header);
+  void add(const Eigen::Vector2d& xy, double intensity);
+  void merge(const IntensityMapBuilder& other);  // same header geometry required
+  std::optional<IntensityCell> cell(const Eigen::Vector2d& xy) const;
+  const IntensityMapHeader& header() const { return header_; }
+  size_t tile_count() const { return tiles_.size(); }
+  // Writes map.yaml and the tiles into `dir` (created; an existing map there is replaced).
+  void save(const std::string& dir) const;
+
+ private:
+  IntensityMapHeader header_;
+  std::map<std::pair<int, int>, std::vector<IntensityMoments>> tiles_;  // row-major, y rows
+};
+
+// Reads a saved map lazily; throws InputError naming the file for a missing or corrupt header or
+// tile, or one that does not match the header.
+class IntensityMap {
+ public:
+  IntensityMap(const std::string& dir, size_t max_cached_tiles = 64);
+  const IntensityMapHeader& header() const { return header_; }
+  // The cell at a local point, if the map has data there.
+  std::optional<IntensityCell> cell(const Eigen::Vector2d& xy);
+  size_t cached_tiles() const { return cache_.size(); }
+  size_t tiles_loaded() const { return loads_; }  // how many tile reads so far
+
+ private:
+  const std::vector<IntensityCell>* tile(int tx, int ty);
+
+  std::string dir_;
+  IntensityMapHeader header_;
+  size_t max_cached_;
+  std::list<std::pair<int, int>> lru_;  // most recently used first
+  std::map<std::pair<int, int>, std::pair<std::vector<IntensityCell>, std::list<std::pair<int, int>>::iterator>> cache_;
+  std::map<std::pair<int, int>, bool> present_;
+  size_t loads_ = 0;
+};
+
+IntensityMapHeader read_intensity_map_header(const std::string& dir);
+
+}  // namespace lidarloop

@@ -1,0 +1,101 @@
+// lidarloop map: build (or find) a world's HD map; the `bench map` memory benchmark lives here too.
+#include <chrono>
+#include <iostream>
+#include <sys/resource.h>
+
+#include <nlohmann/json.hpp>
+
+#include "localizer/curb_layer.hpp"
+#include "sim/path.hpp"
+#include "tools/commands.hpp"
+#include "tools/map_cache.hpp"
+#include "tools/scene_setup.hpp"
+#include "tools/world_assets.hpp"
+
+namespace lidarloop {
+
+namespace {
+
+MappingOptions mapping_options(const Args& args) {
+  MappingOptions o;
+  o.traffic = args.flag("traffic");
+  o.resolution = args.number("resolution", o.resolution);
+  if (o.resolution < 0.05 || o.resolution > 2.0) throw InputError("--resolution must be 0.05 to 2 m");
+  o.speed = args.number("speed", o.speed);
+  if (o.speed < 1 || o.speed > 40) throw InputError("--speed must be 1 to 40 m/s");
+  return o;
+}
+
+int run_map(const Args& args) {
+  const auto limit = limit_threads(thread_count(args));
+  const MapLocation loc = ensure_map(args.positional().at(0), mapping_options(args), args.flag("force"));
+  const IntensityMapHeader h = read_intensity_map_header(loc.dir);
+  std::cout << "map          " << loc.dir << (loc.built ? " (built)" : " (found in the cache)") << "\n";
+  if (loc.built) std::cout << "built in     " << loc.build_s << " s\n";
+  std::cout << "world        " << h.world << " (hash " << h.world_hash << ")\n"
+            << "intensity    " << h.tiles.size() << " tiles of " << h.tile_size_m() << " m, " << h.resolution_m
+            << " m cells; mean.png, variance.png\n"
+            << "curbs        " << loc.dir << "/curbs.geojson\n";
+  return 0;
+}
+
+// What a localizer asks of the map while driving: at every step the curbs around the car and the
+// intensity cells of its 40 m x 40 m grid S. Reports the process's own peak resident set.
+int bench_map(const Args& args) {
+  const std::string world = args.text("world", "campus");
+  const LoadedWorld w = load_world(world);
+  const MapLocation loc = ensure_map(world, MappingOptions{}, false);
+  if (loc.built) throw InputError("bench map measures memory: build the map first with `lidarloop map " + world + "`");
+  const auto t0 = std::chrono::steady_clock::now();
+  const CurbLayer curbs = CurbLayer::load(loc.dir + "/curbs.geojson");
+  const size_t cache_tiles = size_t(args.integer("cache-tiles", 16, 1, 100000));
+  IntensityMap map(loc.dir, cache_tiles);
+  const double step = args.number("step", 12.0);  // m between queries: 1 s at 12 m/s
+  constexpr double kGridHalf = 20.0;               // grid S: 200 x 200 cells of 0.2 m
+  size_t windows = 0, cells = 0, curb_points = 0;
+  for (const auto& road : w.description.roads) {
+    const Path path = lane_path(road, Lane::right, false);
+    for (double s = 0; s < path.length; s += step, ++windows) {
+      const Pose2d p = path.pose_at(s);
+      curb_points += curbs.window({p.x, p.y}, kGridHalf).size();
+      for (double dy = -kGridHalf; dy < kGridHalf; dy += map.header().resolution_m)
+        for (double dx = -kGridHalf; dx < kGridHalf; dx += map.header().resolution_m)
+          if (map.cell({p.x + dx, p.y + dy})) ++cells;
+    }
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const nlohmann::json result = {{"bench", "map"},
+                                 {"world", w.world.name},
+                                 {"map", loc.dir},
+                                 {"tiles_in_map", map.header().tiles.size()},
+                                 {"cache_tiles", cache_tiles},
+                                 {"windows", windows},
+                                 {"cells_with_data", cells},
+                                 {"curb_points_returned", curb_points},
+                                 {"tiles_loaded", map.tiles_loaded()},
+                                 {"ms_per_window", seconds * 1e3 / double(std::max<size_t>(windows, 1))},
+                                 {"peak_rss_mb", double(usage.ru_maxrss) / 1024.0}};
+  std::cout << result.dump(2) << "\n";
+  return 0;
+}
+
+}  // namespace
+
+Command map_command() {
+  return {{"map", "lidarloop map WORLD [--traffic] [--force] [--resolution M] [--speed V]",
+           "Build a world's HD map by a mapping drive over every lane (or find it in the cache): the curb\n"
+           "layer (GeoJSON) and the intensity layer (tiles of per-cell count, mean and variance, Eq. 8).",
+           {{"traffic", "", "oncoming traffic during the drive (raises the variance of the cells it crosses)"},
+            {"force", "", "rebuild even if the cache has this map"},
+            {"resolution", "M", "intensity cell size (default 0.2 m)"},
+            {"speed", "M_S", "mapping drive speed (default 12 m/s)"},
+            {"threads", "N", "worker threads (default: all cores)"}},
+           1, 1},
+          run_map};
+}
+
+int run_bench_map(const Args& args) { return bench_map(args); }
+
+}  // namespace lidarloop
