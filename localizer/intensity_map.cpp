@@ -40,9 +40,10 @@ constexpr double kTileSizeRelativeTolerance = 1e-9;
 // Tile files: little-endian; header, cells, CRC-32 of everything before it.
 constexpr std::array<char, 4> kTileMagic = {'L', 'L', 'I', 'T'};
 constexpr uint32_t kTileVersion = 1;
-constexpr size_t kTileHeaderBytes = 4 + 4 + 4 + 4 + 4;  // magic, version, tile_x, tile_y, tile_cells
-constexpr size_t kCellBytes = 4 + 4 + 4;               // count, mean, m2
-constexpr size_t kCrcBytes = 4;
+constexpr size_t kWordBytes = 4;                        // every field is a 32-bit word
+constexpr size_t kTileHeaderBytes = 5 * kWordBytes;     // magic, version, tile_x, tile_y, tile_cells
+constexpr size_t kCellBytes = 3 * kWordBytes;           // count, mean, m2
+constexpr size_t kCrcBytes = kWordBytes;
 constexpr const char* kTileExtension = ".tile";
 constexpr const char* kTempSuffix = ".tmp";
 
@@ -251,16 +252,16 @@ std::vector<IntensityCell> load_tile(const fs::path& path, const IntensityMapHea
     throw InputError(file + ": not an intensity map tile (bad magic, expected 'LLIT')");
   size_t at = kTileMagic.size();
   const uint32_t version = get_u32(bytes, at);
-  at += 4;
+  at += kWordBytes;
   if (version != kTileVersion)
     throw InputError(file + ": unsupported tile version " + std::to_string(version) + " (expected " +
                      std::to_string(kTileVersion) + ")");
   const int32_t file_tx = get_i32(bytes, at);
-  at += 4;
+  at += kWordBytes;
   const int32_t file_ty = get_i32(bytes, at);
-  at += 4;
+  at += kWordBytes;
   const uint32_t file_cells = get_u32(bytes, at);
-  at += 4;
+  at += kWordBytes;
   if (file_cells != uint32_t(h.tile_cells))
     throw InputError(file + ": tile has tile_cells = " + std::to_string(file_cells) + " but map.yaml says " +
                      std::to_string(h.tile_cells));
@@ -283,8 +284,8 @@ std::vector<IntensityCell> load_tile(const fs::path& path, const IntensityMapHea
   for (size_t i = 0; i < cells.size(); ++i, at += kCellBytes) {
     IntensityCell& c = cells[i];
     c.count = get_u32(bytes, at);
-    c.mean = get_f32(bytes, at + 4);
-    c.m2 = get_f32(bytes, at + 8);
+    c.mean = get_f32(bytes, at + kWordBytes);
+    c.m2 = get_f32(bytes, at + 2 * kWordBytes);
     // A checksum only proves the bytes are the ones written; a hand-made file can still hold nonsense.
     if (!std::isfinite(c.mean) || !std::isfinite(c.m2) || c.m2 < 0)
       throw InputError(file + ": cell (" + std::to_string(i % size_t(h.tile_cells)) + ", " +
@@ -359,8 +360,10 @@ IntensityMapBuilder::IntensityMapBuilder(IntensityMapHeader header) : header_(st
 void IntensityMapBuilder::add(const Eigen::Vector2d& xy, double intensity) {
   // Organised clouds mark "no return" with NaN: not a measurement, so not part of the map.
   if (!xy.allFinite() || !std::isfinite(intensity)) return;
-  const CellIndex c = cell_index(header_, xy);
-  tile_or_new(tiles_, header_, {c.tile_x, c.tile_y})[flat_index(c, header_.tile_cells)].add(intensity);
+  // The header's geometry was checked when the builder was made; this runs once per ground point.
+  const auto c = try_cell_index(header_, xy);
+  if (!c) return;  // beyond any tile index an int can hold: no map covers it
+  tile_or_new(tiles_, header_, {c->tile_x, c->tile_y})[flat_index(*c, header_.tile_cells)].add(intensity);
 }
 
 void IntensityMapBuilder::merge(const IntensityMapBuilder& other) {

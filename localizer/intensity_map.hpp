@@ -87,6 +87,11 @@ class IntensityMapBuilder {
 class IntensityMap {
  public:
   IntensityMap(const std::string& dir, size_t max_cached_tiles = 64);
+  // The cache holds iterators into lru_: a copy would point into the original. Moving keeps them valid.
+  IntensityMap(const IntensityMap&) = delete;
+  IntensityMap& operator=(const IntensityMap&) = delete;
+  IntensityMap(IntensityMap&&) = default;
+  IntensityMap& operator=(IntensityMap&&) = default;
   const IntensityMapHeader& header() const { return header_; }
   // The cell at a local point, if the map has data there.
   std::optional<IntensityCell> cell(const Eigen::Vector2d& xy);

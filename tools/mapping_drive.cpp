@@ -105,11 +105,15 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
       // Ground truth places each point with the pose at its own firing cycle.
       uint32_t cycle = UINT32_MAX;
       Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
+      // The survey car is level: a point higher than this in the sensor frame cannot be ground.
+      const double max_sensor_z = o.max_ground_height - lidar.mount_xyz.z();
       for (const LidarPoint& p : cloud.points) {
+        if (p.z > max_sensor_z || double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z > o.max_range * o.max_range)
+          continue;
         const uint32_t c = uint32_t(p.t_ns / lidar.cycle_period_ns());
         if (c != cycle) cycle = c, sensor = vehicle(stamp + int64_t(c) * lidar.cycle_period_ns()) * mount;
+        if (p.intensity > 100) continue;  // a sign or a reflector, not the road surface
         const Eigen::Vector3d local(p.x, p.y, p.z);
-        if (local.norm() > o.max_range || p.intensity > 100) continue;  // far, or a sign
         const Eigen::Vector3d w = sensor * local;
         if (w.z() > o.max_ground_height) continue;
         builder.add(w.head<2>(), p.intensity);

@@ -13,7 +13,7 @@ namespace lidarloop {
 
 struct MappingOptions {
   bool traffic = false;          // oncoming vehicles on the mapped roads (they raise cell variance)
-  double speed = 12.0;           // m/s along each lane
+  double speed = 15.0;           // m/s along each lane: 1.5 m between scans of 40 m reach
   double resolution = 0.2;       // m per cell
   int tile_cells = 320;          // 64 m tiles at 0.2 m
   // m above the carriageway: asphalt, paint, curbs and sidewalks, and the low parts of vehicles passing
