@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "localizer/curb_layer.hpp"
+#include "localizer/hd_map.hpp"
 #include "test_support.hpp"
 #include "tools/mapping_drive.hpp"
 
@@ -125,6 +128,53 @@ TEST(IntensityLayer, TrafficRaisesTheVarianceOfTheCellsItCrosses) {
   ASSERT_GT(n_busy, 1000);
   EXPECT_GT(busy, 1.3 * clean) << "variance with traffic " << busy << ", without " << clean;
   std::cout << "[ figures  ] oncoming-lane cell variance with traffic " << busy << ", without " << clean << "\n";
+}
+
+}  // namespace
+}  // namespace lidarloop
+
+namespace lidarloop {
+namespace {
+
+// A small saved map of world `name` (with its curbs) in a fresh folder.
+std::string saved_map(const std::string& folder, const std::string& name, const Geodetic& curb_origin) {
+  const std::string dir = testing::TempDir() + "/hd_map_" + folder;
+  IntensityMapHeader h;
+  h.world = name;
+  h.world_hash = "0123456789abcdef";
+  h.origin = {31.28, 121.21, 0};
+  h.tile_cells = 16;
+  IntensityMapBuilder b(h);
+  for (double x = -5; x < 5; x += 0.1) b.add({x, 0.5}, 10 + x);
+  b.save(dir);
+  write_curb_map(dir + "/curbs.geojson", CurbMap{curb_origin, name, {{{-5, 4}, {5, 4}}}});
+  return dir;
+}
+
+TEST(HdMap, OpensBothLayersOfTheExpectedWorld) {
+  const std::string dir = saved_map("good", "campus", {31.28, 121.21, 0});
+  HdMap map = open_hd_map(dir, "campus");
+  EXPECT_NEAR(map.curbs.distance({0, 0}), 4.0, 1e-6);
+  const auto cell = map.intensity.cell({1.05, 0.55});
+  ASSERT_TRUE(cell.has_value());
+  EXPECT_NEAR(cell->mean, 11.0, 0.1);
+}
+
+TEST(HdMap, AMapOfAnotherWorldOrMismatchedLayersIsAnError) {
+  const std::string dir = saved_map("other", "large", {31.28, 121.21, 0});
+  try {
+    open_hd_map(dir, "campus");
+    ADD_FAILURE() << "accepted a map of another world";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + "/map.yaml: this is a map of world 'large', not of 'campus'"),
+              std::string::npos)
+        << e.what();
+  }
+  const std::string shifted = saved_map("shifted", "campus", {31.29, 121.21, 0});
+  EXPECT_THROW(open_hd_map(shifted, "campus"), InputError);
+  const std::string no_curbs = saved_map("no_curbs", "campus", {31.28, 121.21, 0});
+  std::filesystem::remove(no_curbs + "/curbs.geojson");
+  EXPECT_THROW(open_hd_map(no_curbs, "campus"), InputError);
 }
 
 }  // namespace

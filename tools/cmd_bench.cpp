@@ -123,7 +123,8 @@ Command bench_command() {
             {"threads", "N", "worker threads (default: all cores)"},
             {"scans", "N", "lidar: timed scans after two warm-up scans (default 20)"},
             {"cache-tiles", "N", "map: intensity tiles kept in memory (default 16)"},
-            {"step", "M", "map: metres driven between queries (default 12)"}},
+            {"step", "M", "map: metres driven between queries (default 12)"},
+            {"map", "DIR", "map: a map folder to use instead of the world's cached map"}},
            1, 1},
           run_bench};
 }

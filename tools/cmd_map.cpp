@@ -5,7 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "localizer/curb_layer.hpp"
+#include <filesystem>
+
+#include "localizer/hd_map.hpp"
 #include "sim/path.hpp"
 #include "tools/commands.hpp"
 #include "tools/map_cache.hpp"
@@ -44,12 +46,19 @@ int run_map(const Args& args) {
 int bench_map(const Args& args) {
   const std::string world = args.text("world", "campus");
   const LoadedWorld w = load_world(world);
-  const MapLocation loc = ensure_map(world, MappingOptions{}, false);
-  if (loc.built) throw InputError("bench map measures memory: build the map first with `lidarloop map " + world + "`");
+  // The map given, or the cached one (which must exist: building it here would measure the builder).
+  std::string dir = args.text("map", "");
+  if (dir.empty()) {
+    dir = map_cache_root() + "/" + w.world.name + "-" + map_hash(world, MappingOptions{});
+    if (!std::filesystem::exists(dir + "/map.yaml"))
+      throw InputError("no map of '" + w.world.name + "' in the cache: build it first with `lidarloop map " + world +
+                       "`, or give --map DIR");
+  }
   const auto t0 = std::chrono::steady_clock::now();
-  const CurbLayer curbs = CurbLayer::load(loc.dir + "/curbs.geojson");
   const size_t cache_tiles = size_t(args.integer("cache-tiles", 16, 1, 100000));
-  IntensityMap map(loc.dir, cache_tiles);
+  HdMap hd = open_hd_map(dir, w.world.name, cache_tiles);
+  const CurbLayer& curbs = hd.curbs;
+  IntensityMap& map = hd.intensity;
   const double step = args.number("step", 12.0);  // m between queries: 1 s at 12 m/s
   constexpr double kGridHalf = 20.0;               // grid S: 200 x 200 cells of 0.2 m
   size_t windows = 0, cells = 0, curb_points = 0;
@@ -68,7 +77,7 @@ int bench_map(const Args& args) {
   getrusage(RUSAGE_SELF, &usage);
   const nlohmann::json result = {{"bench", "map"},
                                  {"world", w.world.name},
-                                 {"map", loc.dir},
+                                 {"map", dir},
                                  {"tiles_in_map", map.header().tiles.size()},
                                  {"cache_tiles", cache_tiles},
                                  {"windows", windows},

@@ -38,7 +38,7 @@ std::string map_cache_root() {
   return std::string(LIDARLOOP_BUILD_DIR) + "/maps";
 }
 
-MapLocation ensure_map(const std::string& world_name, const MappingOptions& options, bool force) {
+std::string map_hash(const std::string& world_name, const MappingOptions& options) {
   const std::string world_path = world_file(world_name);
   uint64_t h = kFnvOffset;
   hash_file(h, world_path);
@@ -51,10 +51,14 @@ MapLocation ensure_map(const std::string& world_name, const MappingOptions& opti
   hash_bytes(h, options.describe() + " format=" + std::to_string(kMapFormatVersion));
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
 
-  const LoadedWorld w = load_world(world_path);
+MapLocation ensure_map(const std::string& world_name, const MappingOptions& options, bool force) {
+  const std::string world_path = world_file(world_name);
   MapLocation loc;
-  loc.hash = hex;
+  loc.hash = map_hash(world_name, options);
+  const LoadedWorld w = load_world(world_path);
   loc.dir = map_cache_root() + "/" + w.world.name + "-" + loc.hash;
   if (!force && fs::exists(loc.dir + "/map.yaml")) {
     const IntensityMapHeader header = read_intensity_map_header(loc.dir);

@@ -17,6 +17,10 @@ struct MapLocation {
   double build_s = 0;
 };
 
+// The cache key of a world's map: a hash of the world file, the materials, the actor meshes, the
+// mapping options and the map format version.
+std::string map_hash(const std::string& world, const MappingOptions& options);
+
 // Finds the map of `world` (name or world.yaml path) made with `options`, or builds it (or rebuilds
 // it with `force`). Shows progress on a terminal.
 MapLocation ensure_map(const std::string& world, const MappingOptions& options, bool force);
