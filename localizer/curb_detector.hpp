@@ -1,0 +1,29 @@
+#pragma once
+// Single-frame curb detection (paper 2.2.1, after its ref. [41]): along each ground-looking laser
+// ring, a curb shows up as a short, steep rise of 5-30 cm between two flat stretches (the road and the
+// sidewalk). The detected point is the foot of the rise: the road's edge, which is what the curb map
+// records.
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/point_cloud.hpp"
+
+namespace lidarloop {
+
+struct CurbDetectorParams {
+  double min_height = 0.05;        // m: lower steps are road texture or noise
+  double max_height = 0.30;        // m: higher steps are walls, cars, people
+  double step_length = 0.40;       // m along the ring over which the rise must happen
+  double flat_length = 0.50;       // m of ring on each side that must be flat
+  double max_flat_roughness = 0.02;  // m: RMS height spread allowed on a flat stretch
+  double max_range = 25.0;         // m: beyond, ring spacing is too coarse to see a curb
+  double max_ground_height = 0.5;  // m above the vehicle's ground plane (z = 0 in the vehicle frame)
+};
+
+// `points`: the scan in the vehicle frame (x forward, y left, z up from the ground), in firing order.
+// Returns curb points (x, y) in the vehicle frame.
+std::vector<Eigen::Vector2d> detect_curbs(const std::vector<Eigen::Vector3d>& points,
+                                          const std::vector<uint16_t>& rings, const CurbDetectorParams& params);
+
+}  // namespace lidarloop
