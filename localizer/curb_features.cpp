@@ -1,0 +1,85 @@
+#include "localizer/curb_features.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <Eigen/Geometry>
+#include <nanoflann.hpp>
+
+namespace lidarloop {
+
+std::vector<Eigen::Vector2d> to_current_frame(const std::vector<Eigen::Vector2d>& previous, const Odometry2d& m) {
+  const Eigen::Rotation2D<double> back(-m.dpsi);
+  const Eigen::Vector2d d(m.dx, m.dy);
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(previous.size());
+  for (const auto& c : previous) out.push_back(back * (c - d));
+  return out;
+}
+
+void CurbAccumulator::add(const std::vector<Eigen::Vector2d>& curbs, const Odometry2d& motion) {
+  for (auto& frame : history_) frame = to_current_frame(frame, motion);
+  const std::vector<Eigen::Vector2d> moved =
+      to_current_frame(std::vector<Eigen::Vector2d>(origins_.begin(), origins_.end()), motion);
+  origins_.assign(moved.begin(), moved.end());
+  history_.push_front(curbs);
+  origins_.push_front(Eigen::Vector2d::Zero());
+  while (int(history_.size()) > frames_) history_.pop_back(), origins_.pop_back();
+}
+
+std::vector<Eigen::Vector2d> CurbAccumulator::curbs() const {
+  std::vector<Eigen::Vector2d> all;
+  for (const auto& frame : history_) all.insert(all.end(), frame.begin(), frame.end());
+  return all;
+}
+
+namespace {
+struct Cloud2d {  // nanoflann dataset interface
+  const std::vector<Eigen::Vector2d>& points;
+  size_t kdtree_get_point_count() const { return points.size(); }
+  double kdtree_get_pt(size_t i, size_t dim) const { return points[i][int(dim)]; }
+  template <class BBox> bool kdtree_get_bbox(BBox&) const { return false; }
+};
+}  // namespace
+
+std::vector<Eigen::Vector2d> reject_near_obstacles(const std::vector<Eigen::Vector2d>& curbs,
+                                                   const std::vector<Eigen::Vector2d>& obstacles, double distance) {
+  if (obstacles.empty()) return curbs;
+  const Cloud2d cloud{obstacles};
+  nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud2d>, Cloud2d, 2> tree(
+      2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  tree.buildIndex();
+  std::vector<Eigen::Vector2d> kept;
+  for (const auto& c : curbs) {
+    uint32_t index = 0;
+    double d2 = 0;
+    tree.knnSearch(c.data(), 1, &index, &d2);
+    if (d2 > distance * distance) kept.push_back(c);
+  }
+  return kept;
+}
+
+std::vector<Eigen::Vector2d> beam_model(const std::vector<Eigen::Vector2d>& curbs,
+                                        const std::deque<Eigen::Vector2d>& launch_points, const CurbFeatureParams& p) {
+  const double bin = 2 * M_PI / p.beams;  // delta = 2 pi / n_b
+  std::set<size_t> chosen;
+  for (const Eigen::Vector2d& origin : launch_points) {
+    std::vector<std::pair<double, size_t>> nearest(size_t(p.beams), {INFINITY, 0});
+    for (size_t i = 0; i < curbs.size(); ++i) {
+      const Eigen::Vector2d v = curbs[i] - origin;
+      if (std::abs(v.x()) > p.beam_half_extent || std::abs(v.y()) > p.beam_half_extent) continue;  // Eq. 6 box
+      const double angle = std::atan2(v.y(), v.x()) + M_PI;  // [0, 2 pi]
+      const size_t k = std::min(size_t(angle / bin), size_t(p.beams) - 1);
+      const double r = v.norm();
+      if (r < nearest[k].first) nearest[k] = {r, i};  // Eq. 7: the shortest distance in the beam
+    }
+    for (const auto& [r, i] : nearest)
+      if (std::isfinite(r)) chosen.insert(i);
+  }
+  std::vector<Eigen::Vector2d> out;
+  for (size_t i : chosen) out.push_back(curbs[i]);
+  return out;
+}
+
+}  // namespace lidarloop

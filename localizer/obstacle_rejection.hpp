@@ -1,0 +1,51 @@
+#pragma once
+// Obstacle rejection (paper section 2.1.2): the LiDAR points inside the driving corridor are mostly
+// road. A plane fitted by least squares (Eq. 2) to the lowest xi % of them is the ground; points more
+// than d_sigma above it (Eq. 3) are obstacles (cars, pedestrians) and are removed before curb detection
+// and map matching, so they cannot be mistaken for curbs.
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace lidarloop {
+
+// Table I defaults.
+struct ObstacleParams {
+  // xi: share of the corridor points, lowest first, used for the ground fit. The top (1 - xi) are
+  // assumed to hold the obstacles, so they cannot drag the plane upwards.
+  double ground_fraction = 0.95;
+  double obstacle_distance = 0.5;  // d_sigma (m)
+};
+
+// z = a0 x + a1 y + a2 (Eq. 2), in the vehicle frame (z up).
+struct Plane {
+  double a0 = 0, a1 = 0, a2 = 0;
+};
+
+// Sorts the points by z, keeps the lowest `fraction` (at least 3) and solves the normal equations of
+// Eq. 2. Non-finite points are ignored. nullopt with fewer than 3 finite points, fraction not in
+// (0, 1], or a degenerate system (the kept points are collinear in x-y, or a vertical plane).
+std::optional<Plane> fit_ground_plane(std::vector<Eigen::Vector3d> points, double fraction);
+
+// Eq. 3: perpendicular distance from p to the plane (always >= 0).
+double distance_to_plane(const Plane& plane, const Eigen::Vector3d& p);
+// Signed perpendicular distance: positive above the plane (z larger than the plane's z at (x, y)).
+double height_above_plane(const Plane& plane, const Eigen::Vector3d& p);
+
+struct ObstacleSplit {
+  std::vector<Eigen::Vector3d> ground, obstacles;
+  Plane plane;
+  bool plane_ok = false;
+};
+
+// corridor_points: vehicle frame (z up), already inside the driving corridor. Non-finite points are
+// dropped first (in neither output). Obstacle = more than d_sigma from the plane (Eq. 3) AND above it.
+// Eq. 3 uses |d|, but a point far below the road cannot be something the car drives into or something
+// that hides a curb: it is a reflection (wet road, glass; the mirrored return lands under the ground),
+// a dip beyond the fitted patch, or a ditch. Calling it an obstacle would only remove ground evidence.
+// Without a plane (fewer than 3 points, degenerate) nothing is rejected: every point is ground, which
+// degrades to plain ICP rather than to throwing the scan away.
+ObstacleSplit reject_obstacles(const std::vector<Eigen::Vector3d>& corridor_points, const ObstacleParams& params = {});
+
+}  // namespace lidarloop
