@@ -1,0 +1,78 @@
+#pragma once
+// Intensity feature matching (the paper's sections 2.2.2 and 3.2): the ground points of one scan are
+// binned into a vehicle-centred grid S of running intensity statistics (Eq. 8), and S is matched
+// against the intensity layer of the map by APS (Levinson & Thrun, the paper's ref. [22]): every
+// offset of a small search window gets a probability (Eq. 14), and the centre of mass of that
+// distribution is the position estimate (Eq. 15-18).
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/vehicle_messages.hpp"
+#include "localizer/intensity_map.hpp"
+
+namespace lidarloop {
+
+// Grid S (Table I: w_s = h_s = 200). Its cells must be the map's cells, so that the search can shift
+// S by whole cells; aps_match checks this.
+struct IntensityGridParams {
+  int width_cells = 200;   // w_s: along x (forward)
+  int height_cells = 200;  // h_s: along y (left)
+  double cell_m = 0.2;
+};
+
+// Row-major, in the vehicle frame: x forward along the columns, y left along the rows, the vehicle at
+// the centre of the grid (cell (c, r) spans x in [(c - w/2) cell, (c + 1 - w/2) cell), likewise y).
+struct IntensityGrid {
+  Pose2d pose;  // the local pose the grid was built at (the prior of the match)
+  IntensityGridParams params;
+  std::vector<IntensityCell> cells;
+
+  // Throws std::out_of_range outside the grid.
+  const IntensityCell& at(int col, int row) const;
+  // Centre of cell (col, row) in the vehicle frame.
+  Eigen::Vector2d cell_centre(int col, int row) const;
+};
+
+// Bins ground points (vehicle frame; z is ignored) with their intensities into S by Eq. 8. Points off
+// the grid or not finite are skipped. Throws std::invalid_argument for mismatched sizes or bad params.
+IntensityGrid build_intensity_grid(const std::vector<Eigen::Vector3d>& ground_points_vehicle,
+                                   const std::vector<double>& intensities, const Pose2d& pose,
+                                   const IntensityGridParams& params = {});
+
+struct ApsParams {
+  double lateral_range_m = 1.0;       // section 3.2: +-1 m across the road (curbs fix the lateral)
+  double longitudinal_range_m = 3.0;  // section 3.2: +-3 m along it
+  double step_m = 0.2;                // search step; a whole number of map cells (the paper: one cell)
+  // Eq. 14's exponent. The cells of S are not independent (neighbouring cells see the same paint,
+  // map and scan errors are correlated), so the plain product is far too confident; alpha < 1 tempers
+  // it, as in APS. The paper gives no value; 0.5 keeps the peak on features while leaving a
+  // featureless road broad.
+  double alpha = 0.5;
+  int min_count = 3;  // n_e: only cells of S with S_n > n_e take part (fewer points: mean too noisy)
+  // Floor on the standard deviations of Eq. 14 (intensity counts). A cell hit by one point, or by
+  // points of equal intensity, has zero variance; without a floor one such cell would make the
+  // denominator vanish and decide the whole product.
+  double min_sigma = 1.0;
+  int min_cells = 50;  // fewer usable cells than this: no estimate (ok = false)
+};
+
+struct ApsResult {
+  bool ok = false;  // false: too few usable cells; the caller must not use the estimate
+  // (longitudinal, lateral) offset x_o, y_o of Eq. 15-16, vehicle frame (m). Always inside the search
+  // window: a larger error cannot be recovered.
+  Eigen::Vector2d offset_vehicle = Eigen::Vector2d::Zero();
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // Eq. 17-18: corrected position, local frame
+  // Covariance of P over the offsets (plus the step's quantisation), local frame (m^2): the
+  // observation noise for the Kalman filter. When !ok: that of a uniform spread over the window.
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();
+  int cells_used = 0;  // cells of S that entered Eq. 14
+};
+
+// APS over the window of offsets around S.pose. A cell of S takes part only if S_n > n_e and the map
+// has data under it at every offset of the window, so every offset is scored on the same cells (an
+// offset that moved S off the map would otherwise lose penalty terms and look better). Throws
+// std::invalid_argument if S's cell size is not the map's resolution or a parameter is out of range.
+ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& params = {});
+
+}  // namespace lidarloop

@@ -1,0 +1,292 @@
+// APS intensity matching (sections 2.2.2 and 3.2, Eq. 8 and 14-18): grid S binning, recovery of a
+// known offset on a crosswalk with the vehicle turned 30 degrees, the limit of the search window, a
+// broad distribution on a featureless road, and refusal of too little data or mismatched cells.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <Eigen/Dense>
+
+#include "localizer/aps_matcher.hpp"
+#include "localizer/intensity_map.hpp"
+
+namespace lidarloop {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kResolution = 0.2;  // the map's cells and S's (Table I scale)
+const Geodetic kCampus{31.2856, 121.2147, 4.0};
+
+// The mapped area: a 60 m x 20 m stretch of road along local x.
+constexpr double kMapMinX = 0, kMapMaxX = 60, kMapMinY = -10, kMapMaxY = 10;
+constexpr double kMapPointsPerCell = 25;   // a mapping drive passes several times
+constexpr double kScanPointsPerCell = 10;  // one scan sees less
+
+// A crosswalk: stripes 0.45 m wide every 1.05 m along the road, 6 m long across it. A finite number of
+// stripes, so a shift by one period is not a match (the ends differ).
+constexpr double kStripeWidth = 0.45, kStripePeriod = 1.05, kCrosswalkStartX = 26.0;
+constexpr int kStripes = 8;
+constexpr double kCrosswalkHalfLength = 3.0;
+constexpr double kPaint = 35, kPaintNoise = 4, kAsphalt = 6, kAsphaltNoise = 1.5;  // intensity counts
+
+// Truth and the error of the prior, in the vehicle frame (longitudinal, lateral).
+const Pose2d kTruth{30.3, 0.1, 30.0 * std::numbers::pi / 180.0};
+const Eigen::Vector2d kPriorError(1.2, -0.4);
+
+using Pattern = bool (*)(const Eigen::Vector2d&);  // is there paint at this local point?
+
+bool crosswalk(const Eigen::Vector2d& p) {
+  if (std::fabs(p.y()) > kCrosswalkHalfLength) return false;
+  const double u = p.x() - kCrosswalkStartX;
+  if (u < 0 || u >= kStripes * kStripePeriod) return false;
+  return std::fmod(u, kStripePeriod) < kStripeWidth;
+}
+
+bool plain_asphalt(const Eigen::Vector2d&) { return false; }
+
+bool on_map(const Eigen::Vector2d& p) {
+  return p.x() >= kMapMinX && p.x() < kMapMaxX && p.y() >= kMapMinY && p.y() < kMapMaxY;
+}
+
+double intensity(Pattern pattern, const Eigen::Vector2d& p, std::mt19937& rng) {
+  const bool paint = pattern(p);
+  std::normal_distribution<double> noise(0.0, paint ? kPaintNoise : kAsphaltNoise);
+  return (paint ? kPaint : kAsphalt) + noise(rng);
+}
+
+Eigen::Matrix2d rotation(double yaw) {
+  Eigen::Matrix2d r;
+  r << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
+  return r;
+}
+
+// The pose a localizer would believe: the truth moved by `error` (vehicle frame) the wrong way, so the
+// correct answer of the match is offset == error.
+Pose2d prior_from(const Pose2d& truth, const Eigen::Vector2d& error) {
+  const Eigen::Vector2d p = Eigen::Vector2d(truth.x, truth.y) - rotation(truth.yaw) * error;
+  return {p.x(), p.y(), truth.yaw};
+}
+
+std::string build_map(Pattern pattern, const std::string& name, uint32_t seed) {
+  IntensityMapHeader h;
+  h.world = "aps_test";
+  h.world_hash = "0123456789abcdef";
+  h.origin = kCampus;
+  h.resolution_m = kResolution;
+  IntensityMapBuilder builder(h);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> ux(kMapMinX, kMapMaxX), uy(kMapMinY, kMapMaxY);
+  const double area = (kMapMaxX - kMapMinX) * (kMapMaxY - kMapMinY);
+  const int points = static_cast<int>(area / (kResolution * kResolution) * kMapPointsPerCell);
+  for (int i = 0; i < points; ++i) {
+    const Eigen::Vector2d p(ux(rng), uy(rng));
+    builder.add(p, intensity(pattern, p, rng));
+  }
+  const fs::path dir = fs::path(::testing::TempDir()) / ("lidarloop_aps_" + name + "_" + std::to_string(::getpid()));
+  builder.save(dir.string());
+  return dir.string();
+}
+
+// Ground points of one scan at `truth`, in the vehicle frame, over grid S and the mapped area.
+struct Scan {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> intensities;
+};
+
+Scan scan_at(Pattern pattern, const Pose2d& truth, const IntensityGridParams& g, uint32_t seed) {
+  Scan scan;
+  std::mt19937 rng(seed);
+  const double half_x = 0.5 * g.width_cells * g.cell_m, half_y = 0.5 * g.height_cells * g.cell_m;
+  std::uniform_real_distribution<double> ux(-half_x, half_x), uy(-half_y, half_y);
+  const int samples = static_cast<int>(double(g.width_cells) * g.height_cells * kScanPointsPerCell);
+  const Eigen::Matrix2d R = rotation(truth.yaw);
+  for (int i = 0; i < samples; ++i) {
+    const Eigen::Vector2d v(ux(rng), uy(rng));
+    const Eigen::Vector2d local = Eigen::Vector2d(truth.x, truth.y) + R * v;
+    if (!on_map(local)) continue;  // the scan's ground outside the mapped road is not modelled
+    scan.points.emplace_back(v.x(), v.y(), 0.0);
+    scan.intensities.push_back(intensity(pattern, local, rng));
+  }
+  return scan;
+}
+
+// Local-frame covariance back in the vehicle frame (longitudinal, lateral).
+Eigen::Matrix2d vehicle_covariance(const ApsResult& r, double yaw) {
+  return rotation(yaw).transpose() * r.covariance * rotation(yaw);
+}
+
+// Position error in the vehicle frame (longitudinal, lateral).
+Eigen::Vector2d vehicle_error(const ApsResult& r, const Pose2d& truth) {
+  return rotation(truth.yaw).transpose() * (r.position - Eigen::Vector2d(truth.x, truth.y));
+}
+
+class Aps : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    crosswalk_dir_ = new std::string(build_map(crosswalk, "crosswalk", 1));
+    asphalt_dir_ = new std::string(build_map(plain_asphalt, "asphalt", 2));
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*crosswalk_dir_);
+    fs::remove_all(*asphalt_dir_);
+    delete crosswalk_dir_;
+    delete asphalt_dir_;
+  }
+  static std::string* crosswalk_dir_;
+  static std::string* asphalt_dir_;
+};
+std::string* Aps::crosswalk_dir_ = nullptr;
+std::string* Aps::asphalt_dir_ = nullptr;
+
+// ---------------------------------------------------------------------------------------------------
+// Grid S (Eq. 8)
+
+TEST(ApsGrid, BinsPointsAroundTheVehicleAndKeepsRunningStatistics) {
+  const IntensityGridParams g;  // 200 x 200 at 0.2 m: +-20 m
+  const std::vector<Eigen::Vector3d> points{{0.1, 0.1, 0}, {0.15, 0.05, 0}, {0.19, 0.01, 0},
+                                            {-0.1, -0.1, 0}, {19.9, -19.9, 0}, {20.1, 0, 0}};
+  const std::vector<double> values{10, 20, 30, 7, 5, 99};
+  const IntensityGrid S = build_intensity_grid(points, values, Pose2d{}, g);
+  ASSERT_EQ(S.cells.size(), 40000u);
+  // The vehicle is at the corner of the four central cells.
+  EXPECT_EQ(S.at(100, 100).count, 3u);
+  EXPECT_NEAR(S.at(100, 100).mean, 20.0, 1e-5);
+  EXPECT_NEAR(S.at(100, 100).variance(), 200.0 / 3.0, 1e-4);  // population variance of 10, 20, 30
+  EXPECT_EQ(S.at(99, 99).count, 1u);
+  EXPECT_EQ(S.at(199, 0).count, 1u);
+  EXPECT_NEAR(S.cell_centre(100, 100).x(), 0.1, 1e-12);
+  uint32_t total = 0;
+  for (const IntensityCell& c : S.cells) total += c.count;
+  EXPECT_EQ(total, 5u);  // the point 20.1 m ahead is off the grid
+  EXPECT_THROW(S.at(200, 0), std::out_of_range);
+  EXPECT_THROW(build_intensity_grid(points, {1.0}, Pose2d{}, g), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Matching (Eq. 14-18)
+
+TEST_F(Aps, RecoversAKnownOffsetOnACrosswalkWithTheVehicleTurned) {
+  IntensityMap map(*crosswalk_dir_);
+  const IntensityGridParams g;
+  const Scan scan = scan_at(crosswalk, kTruth, g, 3);
+  const Pose2d prior = prior_from(kTruth, kPriorError);
+  const IntensityGrid S = build_intensity_grid(scan.points, scan.intensities, prior, g);
+  const ApsParams params;
+
+  const auto start = std::chrono::steady_clock::now();
+  const ApsResult r = aps_match(S, map, params);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+
+  ASSERT_TRUE(r.ok);
+  const Eigen::Vector2d err = vehicle_error(r, kTruth);
+  EXPECT_LT(std::fabs(err.x()), kResolution) << "longitudinal error";
+  EXPECT_LT(std::fabs(err.y()), kResolution) << "lateral error";
+  EXPECT_NEAR(r.offset_vehicle.x(), kPriorError.x(), kResolution);
+  EXPECT_NEAR(r.offset_vehicle.y(), kPriorError.y(), kResolution);
+  const Eigen::Matrix2d cv = vehicle_covariance(r, kTruth.yaw);
+  std::printf("[ aps ] crosswalk: offset (%.3f, %.3f) m, truth (%.1f, %.1f); std (%.3f, %.3f) m; %d cells; %.1f ms\n",
+              r.offset_vehicle.x(), r.offset_vehicle.y(), kPriorError.x(), kPriorError.y(), std::sqrt(cv(0, 0)),
+              std::sqrt(cv(1, 1)), r.cells_used, ms);
+  // The map is read: the estimate is not just the prior.
+  EXPECT_GT((r.position - Eigen::Vector2d(prior.x, prior.y)).norm(), 1.0);
+}
+
+TEST_F(Aps, AnErrorBeyondTheSearchWindowIsNotRecovered) {
+  IntensityMap map(*crosswalk_dir_);
+  const IntensityGridParams g;
+  const ApsParams params;
+  const Eigen::Vector2d too_far(params.longitudinal_range_m + 1.5, 0.0);
+  const Scan scan = scan_at(crosswalk, kTruth, g, 4);
+  const IntensityGrid S = build_intensity_grid(scan.points, scan.intensities, prior_from(kTruth, too_far), g);
+  const ApsResult r = aps_match(S, map, params);
+  ASSERT_TRUE(r.ok);
+  // The centre of mass of a distribution over the window cannot leave it...
+  EXPECT_LE(std::fabs(r.offset_vehicle.x()), params.longitudinal_range_m + 1e-9);
+  EXPECT_LE(std::fabs(r.offset_vehicle.y()), params.lateral_range_m + 1e-9);
+  // ...so at least the excess remains as error.
+  const Eigen::Vector2d err = vehicle_error(r, kTruth);
+  std::printf("[ aps ] beyond window: offset (%.3f, %.3f) m for an error of (%.1f, %.1f)\n", r.offset_vehicle.x(),
+              r.offset_vehicle.y(), too_far.x(), too_far.y());
+  EXPECT_GT(err.norm(), too_far.x() - params.longitudinal_range_m - 1e-9);
+}
+
+TEST_F(Aps, AFeaturelessRoadGivesABroadDistribution) {
+  const IntensityGridParams g;
+  const ApsParams params;
+  const Pose2d prior = prior_from(kTruth, kPriorError);
+
+  IntensityMap flat(*asphalt_dir_);
+  const Scan flat_scan = scan_at(plain_asphalt, kTruth, g, 5);
+  const ApsResult r_flat = aps_match(build_intensity_grid(flat_scan.points, flat_scan.intensities, prior, g), flat, params);
+
+  IntensityMap marked(*crosswalk_dir_);
+  const Scan marked_scan = scan_at(crosswalk, kTruth, g, 5);
+  const ApsResult r_marked =
+      aps_match(build_intensity_grid(marked_scan.points, marked_scan.intensities, prior, g), marked, params);
+
+  ASSERT_TRUE(r_flat.ok);
+  ASSERT_TRUE(r_marked.ok);
+  const Eigen::Matrix2d c_flat = vehicle_covariance(r_flat, kTruth.yaw);
+  const Eigen::Matrix2d c_marked = vehicle_covariance(r_marked, kTruth.yaw);
+  std::printf("[ aps ] std (long, lat): flat (%.3f, %.3f) m, crosswalk (%.3f, %.3f) m\n", std::sqrt(c_flat(0, 0)),
+              std::sqrt(c_flat(1, 1)), std::sqrt(c_marked(0, 0)), std::sqrt(c_marked(1, 1)));
+  EXPECT_GT(std::sqrt(c_flat(0, 0)), 0.5);
+  EXPECT_GT(c_flat.trace(), 10 * c_marked.trace());
+}
+
+TEST_F(Aps, TooFewUsableCellsGiveNoEstimate) {
+  IntensityMap map(*crosswalk_dir_);
+  const IntensityGridParams g;
+  const ApsParams params;
+  const Pose2d prior = prior_from(kTruth, kPriorError);
+  // Points in a 1 m x 1 m patch: 25 cells, fewer than min_cells.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> values;
+  for (double x = 0.01; x < 1.0; x += 0.05)
+    for (double y = 0.01; y < 1.0; y += 0.05) {
+      points.emplace_back(x, y, 0.0);
+      values.push_back(kAsphalt);
+    }
+  const ApsResult r = aps_match(build_intensity_grid(points, values, prior, g), map, params);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.cells_used, 25);
+  EXPECT_EQ(r.position, Eigen::Vector2d(prior.x, prior.y));
+
+  // Cells with no more than n_e points do not count either: one point in every cell of S.
+  std::vector<Eigen::Vector3d> one_each;
+  const IntensityGrid empty = build_intensity_grid({}, {}, prior, g);
+  for (int row = 0; row < g.height_cells; ++row)
+    for (int col = 0; col < g.width_cells; ++col) {
+      const Eigen::Vector2d c = empty.cell_centre(col, row);
+      one_each.emplace_back(c.x(), c.y(), 0.0);
+    }
+  const ApsResult sparse =
+      aps_match(build_intensity_grid(one_each, std::vector<double>(one_each.size(), kAsphalt), prior, g), map, params);
+  EXPECT_FALSE(sparse.ok);
+  EXPECT_EQ(sparse.cells_used, 0);
+}
+
+TEST_F(Aps, GridCellsMustBeTheMapsCells) {
+  IntensityMap map(*crosswalk_dir_);
+  IntensityGridParams g;
+  g.cell_m = 0.25;
+  const IntensityGrid S = build_intensity_grid({}, {}, kTruth, g);
+  EXPECT_THROW(aps_match(S, map, ApsParams{}), std::invalid_argument);
+  ApsParams half_step;
+  half_step.step_m = 0.1;  // not a whole number of cells
+  EXPECT_THROW(aps_match(build_intensity_grid({}, {}, kTruth, IntensityGridParams{}), map, half_step),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace lidarloop
