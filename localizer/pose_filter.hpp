@@ -36,7 +36,8 @@ class MotionPredictor {
 };
 
 struct PoseFilterParams {
-  double process_position_per_m = 0.2;   // m of position noise per m driven (odometry scale, slip)
+  double process_position_per_m = 0.2;   // m per m driven: wheel slip, scale error and model error, set so
+                                          // the filter follows GPS rather than lagging its slow bias
   double process_yaw_per_m = 0.002;       // rad per m driven
   double process_position_per_s = 0.2;   // m per sqrt(s): what odometry cannot see (keeps GPS gain up)
 };
