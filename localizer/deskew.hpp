@@ -1,0 +1,28 @@
+#pragma once
+// Scan de-skew (beyond the paper; issue 5 asks for it): a Velodyne reports each point in the sensor
+// frame of its own firing instant, so a scan taken while driving is skewed (1 m over a 10 Hz scan at
+// 10 m/s). With the vehicle's speed and yaw rate from CAN over the scan, every point is brought into
+// the vehicle frame at one reference time, so the matchers see the world as it is.
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "common/point_cloud.hpp"
+
+namespace lidarloop {
+
+struct ScanMotion {
+  double speed = 0;     // m/s along the vehicle's x (rear axle)
+  double yaw_rate = 0;  // rad/s
+};
+
+// Points of `cloud` in the vehicle frame (origin at the rear axle) at time `reference_ns` after the
+// scan's stamp, assuming constant speed and yaw rate over the scan (a circular arc). `mount` is the
+// LiDAR's pose in the vehicle frame. Non-finite points are dropped.
+std::vector<Eigen::Vector3d> deskew(const PointCloud& cloud, const Eigen::Isometry3d& mount, const ScanMotion& motion,
+                                    int64_t reference_ns);
+
+// Without motion compensation: every point through the mount only (what a naive consumer does).
+std::vector<Eigen::Vector3d> to_vehicle_frame(const PointCloud& cloud, const Eigen::Isometry3d& mount);
+
+}  // namespace lidarloop
