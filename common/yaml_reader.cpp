@@ -80,6 +80,10 @@ double YamlReader::number_in(const YAML::Node& node, std::string_view what, doub
   return value;
 }
 
+void YamlReader::read_number(const YAML::Node& map, const char* key, double& value, double lo, double hi) const {
+  if (const YAML::Node n = map[key]) value = number_in(n, key, lo, hi);
+}
+
 long YamlReader::integer_in(const YAML::Node& node, std::string_view what, long lo, long hi) const {
   long value = 0;
   if (!node.IsScalar() || !YAML::convert<long>::decode(node, value))

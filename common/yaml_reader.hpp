@@ -33,6 +33,8 @@ class YamlReader {
   double number(const YAML::Node& node, std::string_view what) const;  // finite
   double number_in(const YAML::Node& node, std::string_view what, double lo, double hi) const;
   long integer_in(const YAML::Node& node, std::string_view what, long lo, long hi) const;
+  // Overwrites `value` with map[key] when the key is present (range-checked); keeps it otherwise.
+  void read_number(const YAML::Node& map, const char* key, double& value, double lo, double hi) const;
   bool boolean(const YAML::Node& node, std::string_view what) const;
   std::string string(const YAML::Node& node, std::string_view what) const;
   Eigen::Vector2d vec2(const YAML::Node& node, std::string_view what) const;

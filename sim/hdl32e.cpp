@@ -38,9 +38,6 @@ void read_hdl32e_config(const YamlReader& y, const YAML::Node& n, Hdl32eConfig& 
                    "intensity_reference_range_m", "intensity_range_exponent", "intensity_noise",
                    "laser_gain_spread", "unit_serial", "mount_xyz", "mount_rpy_deg", "motion_distortion",
                    "cycles_per_actor_update"});
-  auto num = [&](const char* key, double& v, double lo, double hi) {
-    if (n[key]) v = y.number_in(n[key], key, lo, hi);
-  };
   if (const YAML::Node e = n["elevation_deg"]) {
     if (!e.IsSequence() || e.size() != kHdl32eLasers) y.fail(e, "elevation_deg must list 32 elevations");
     for (int i = 0; i < kHdl32eLasers; ++i) c.elevation_deg[i] = y.number_in(e[i], "elevation_deg", -90.0, 90.0);
@@ -57,22 +54,22 @@ void read_hdl32e_config(const YamlReader& y, const YAML::Node& n, Hdl32eConfig& 
   if (n["firing_period_ns"]) c.firing_period_ns = y.integer_in(n["firing_period_ns"], "firing_period_ns", 100, 100000);
   if (n["slots_per_cycle"])
     c.slots_per_cycle = int(y.integer_in(n["slots_per_cycle"], "slots_per_cycle", kHdl32eLasers, 1000));
-  num("rotation_hz", c.rotation_hz, 5.0, 20.0);
-  num("scan_start_yaw_deg", c.scan_start_yaw_deg, -360.0, 360.0);
-  num("min_range_m", c.min_range_m, 0.0, 10.0);
-  num("max_range_m", c.max_range_m, 1.0, 300.0);
-  num("range_resolution_m", c.range_resolution_m, 0.0, 0.1);
-  num("range_noise_m", c.range_noise_m, 0.0, 1.0);
-  num("dark_target_reflectivity", c.dark_target_reflectivity, 0.001, 1.0);
-  num("dark_target_range_m", c.dark_target_range_m, 1.0, 1000.0);
-  num("detection_incidence_exponent", c.detection_incidence_exponent, 0.0, 4.0);
-  num("detection_softness", c.detection_softness, 0.0, 2.0);
-  num("max_incidence_deg", c.max_incidence_deg, 0.0, 90.0);
-  num("intensity_incidence_exponent", c.intensity_incidence_exponent, 0.0, 4.0);
-  num("intensity_reference_range_m", c.intensity_reference_range_m, 0.1, 1000.0);
-  num("intensity_range_exponent", c.intensity_range_exponent, 0.0, 4.0);
-  num("intensity_noise", c.intensity_noise, 0.0, 50.0);
-  num("laser_gain_spread", c.laser_gain_spread, 0.0, 0.5);
+  y.read_number(n, "rotation_hz", c.rotation_hz, 5.0, 20.0);
+  y.read_number(n, "scan_start_yaw_deg", c.scan_start_yaw_deg, -360.0, 360.0);
+  y.read_number(n, "min_range_m", c.min_range_m, 0.0, 10.0);
+  y.read_number(n, "max_range_m", c.max_range_m, 1.0, 300.0);
+  y.read_number(n, "range_resolution_m", c.range_resolution_m, 0.0, 0.1);
+  y.read_number(n, "range_noise_m", c.range_noise_m, 0.0, 1.0);
+  y.read_number(n, "dark_target_reflectivity", c.dark_target_reflectivity, 0.001, 1.0);
+  y.read_number(n, "dark_target_range_m", c.dark_target_range_m, 1.0, 1000.0);
+  y.read_number(n, "detection_incidence_exponent", c.detection_incidence_exponent, 0.0, 4.0);
+  y.read_number(n, "detection_softness", c.detection_softness, 0.0, 2.0);
+  y.read_number(n, "max_incidence_deg", c.max_incidence_deg, 0.0, 90.0);
+  y.read_number(n, "intensity_incidence_exponent", c.intensity_incidence_exponent, 0.0, 4.0);
+  y.read_number(n, "intensity_reference_range_m", c.intensity_reference_range_m, 0.1, 1000.0);
+  y.read_number(n, "intensity_range_exponent", c.intensity_range_exponent, 0.0, 4.0);
+  y.read_number(n, "intensity_noise", c.intensity_noise, 0.0, 50.0);
+  y.read_number(n, "laser_gain_spread", c.laser_gain_spread, 0.0, 0.5);
   if (n["unit_serial"]) c.unit_serial = uint64_t(y.integer_in(n["unit_serial"], "unit_serial", 0, 1L << 40));
   if (n["mount_xyz"]) c.mount_xyz = y.vec3(n["mount_xyz"], "mount_xyz");
   if (n["mount_rpy_deg"]) c.mount_rpy_deg = y.vec3(n["mount_rpy_deg"], "mount_rpy_deg");

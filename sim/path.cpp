@@ -8,6 +8,10 @@ namespace lidarloop {
 
 constexpr double kCurvatureWindow = 2.0;  // m either side: smooths the polyline's 3-degree arc steps
 
+Eigen::Isometry3d to_isometry(const Pose2d& p) {
+  return Eigen::Translation3d(p.x, p.y, 0) * Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ());
+}
+
 Path make_path(Polyline2d points, bool closed) {
   Path p;
   p.points = std::move(points);

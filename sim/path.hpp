@@ -2,6 +2,8 @@
 // Paths that the ego and traffic follow: lane centres along the world's roads, lines across
 // crosswalks, or explicit waypoints; and positions on them by arc length.
 #include <string>
+
+#include <Eigen/Geometry>
 #include <vector>
 
 #include "common/vehicle_messages.hpp"
@@ -25,6 +27,9 @@ struct Path {
 };
 
 Path make_path(Polyline2d points, bool closed);
+
+// A planar pose as a 3-D transform on the ground (z = 0).
+Eigen::Isometry3d to_isometry(const Pose2d& pose);
 
 enum class Lane { right, left };  // in the direction of travel
 

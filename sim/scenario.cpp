@@ -78,18 +78,15 @@ void read_can(const YamlReader& y, const YAML::Node& n, CanConfig& c) {
   y.allow_keys(n, {"rate_hz", "wheel_speed_resolution_mps", "wheel_speed_noise_mps", "wheel_speed_scale_error",
                    "min_detectable_speed_mps", "steering_resolution_rad", "steering_noise_rad", "steering_offset_rad", "latency_ms",
                    "dropout_probability"});
-  auto num = [&](const char* key, double& v, double lo, double hi) {
-    if (n[key]) v = y.number_in(n[key], key, lo, hi);
-  };
-  num("rate_hz", c.rate_hz, 1.0, 1000.0);
-  num("wheel_speed_resolution_mps", c.wheel_speed_resolution_mps, 0.0, 1.0);
-  num("wheel_speed_noise_mps", c.wheel_speed_noise_mps, 0.0, 5.0);
-  num("wheel_speed_scale_error", c.wheel_speed_scale_error, -0.2, 0.2);
-  num("min_detectable_speed_mps", c.min_detectable_speed_mps, 0.0, 2.0);
-  num("steering_resolution_rad", c.steering_resolution_rad, 0.0, 0.1);
-  num("steering_noise_rad", c.steering_noise_rad, 0.0, 0.5);
-  num("steering_offset_rad", c.steering_offset_rad, -0.5, 0.5);
-  num("dropout_probability", c.dropout_probability, 0.0, 0.99);
+  y.read_number(n, "rate_hz", c.rate_hz, 1.0, 1000.0);
+  y.read_number(n, "wheel_speed_resolution_mps", c.wheel_speed_resolution_mps, 0.0, 1.0);
+  y.read_number(n, "wheel_speed_noise_mps", c.wheel_speed_noise_mps, 0.0, 5.0);
+  y.read_number(n, "wheel_speed_scale_error", c.wheel_speed_scale_error, -0.2, 0.2);
+  y.read_number(n, "min_detectable_speed_mps", c.min_detectable_speed_mps, 0.0, 2.0);
+  y.read_number(n, "steering_resolution_rad", c.steering_resolution_rad, 0.0, 0.1);
+  y.read_number(n, "steering_noise_rad", c.steering_noise_rad, 0.0, 0.5);
+  y.read_number(n, "steering_offset_rad", c.steering_offset_rad, -0.5, 0.5);
+  y.read_number(n, "dropout_probability", c.dropout_probability, 0.0, 0.99);
   if (n["latency_ms"]) c.latency_ns = std::llround(y.number_in(n["latency_ms"], "latency_ms", 0.0, 1000.0) * 1e6);
 }
 
@@ -97,17 +94,16 @@ void read_gps(const YamlReader& y, const YAML::Node& n, GpsConfig& g) {
   y.expect_map(n, "gps");
   y.allow_keys(n, {"rate_hz", "bias_sigma_m", "bias_tau_s", "white_sigma_m", "vertical_sigma_m",
                    "heading_bias_sigma_deg", "heading_bias_tau_s", "heading_white_sigma_deg", "zones"});
-  auto num = [&](const char* key, double& v, double lo, double hi, double scale = 1.0) {
-    if (n[key]) v = y.number_in(n[key], key, lo, hi) * scale;
-  };
-  num("rate_hz", g.rate_hz, 0.1, 100.0);
-  num("bias_sigma_m", g.bias_sigma_m, 0.0, 100.0);
-  num("bias_tau_s", g.bias_tau_s, 0.1, 1e5);
-  num("white_sigma_m", g.white_sigma_m, 0.0, 100.0);
-  num("vertical_sigma_m", g.vertical_sigma_m, 0.0, 100.0);
-  num("heading_bias_sigma_deg", g.heading_bias_sigma_rad, 0.0, 90.0, kDeg);
-  num("heading_bias_tau_s", g.heading_bias_tau_s, 0.1, 1e5);
-  num("heading_white_sigma_deg", g.heading_white_sigma_rad, 0.0, 90.0, kDeg);
+  y.read_number(n, "rate_hz", g.rate_hz, 0.1, 100.0);
+  y.read_number(n, "bias_sigma_m", g.bias_sigma_m, 0.0, 100.0);
+  y.read_number(n, "bias_tau_s", g.bias_tau_s, 0.1, 1e5);
+  y.read_number(n, "white_sigma_m", g.white_sigma_m, 0.0, 100.0);
+  y.read_number(n, "vertical_sigma_m", g.vertical_sigma_m, 0.0, 100.0);
+  if (n["heading_bias_sigma_deg"])
+    g.heading_bias_sigma_rad = y.number_in(n["heading_bias_sigma_deg"], "heading_bias_sigma_deg", 0.0, 90.0) * kDeg;
+  y.read_number(n, "heading_bias_tau_s", g.heading_bias_tau_s, 0.1, 1e5);
+  if (n["heading_white_sigma_deg"])
+    g.heading_white_sigma_rad = y.number_in(n["heading_white_sigma_deg"], "heading_white_sigma_deg", 0.0, 90.0) * kDeg;
   if (const YAML::Node zones = n["zones"]) {
     y.expect_sequence(zones, "zones");
     for (const auto& z : zones) {
@@ -157,14 +153,11 @@ EgoSpec read_ego(const YamlReader& y, const YAML::Node& n, const VehicleParams& 
   if (const YAML::Node c = n["controller"]) {
     y.expect_map(c, "controller");
     y.allow_keys(c, {"stanley_gain", "heading_gain", "preview_s", "max_lateral_accel", "comfort_decel"});
-    auto num = [&](const char* key, double& v, double lo, double hi) {
-      if (c[key]) v = y.number_in(c[key], key, lo, hi);
-    };
-    num("stanley_gain", e.controller.stanley_gain, 0.0, 20.0);
-    num("heading_gain", e.controller.heading_gain, 0.0, 5.0);
-    num("preview_s", e.controller.preview_s, 0.0, 2.0);
-    num("max_lateral_accel", e.controller.max_lateral_accel, 0.5, 8.0);
-    num("comfort_decel", e.controller.comfort_decel, 0.5, 8.0);
+    y.read_number(c, "stanley_gain", e.controller.stanley_gain, 0.0, 20.0);
+    y.read_number(c, "heading_gain", e.controller.heading_gain, 0.0, 5.0);
+    y.read_number(c, "preview_s", e.controller.preview_s, 0.0, 2.0);
+    y.read_number(c, "max_lateral_accel", e.controller.max_lateral_accel, 0.5, 8.0);
+    y.read_number(c, "comfort_decel", e.controller.comfort_decel, 0.5, 8.0);
   }
   return e;
 }

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 namespace lidarloop {
 
@@ -10,10 +9,6 @@ constexpr int64_t kControlPeriodNs = 10'000'000;  // the driver acts at 100 Hz
 constexpr int64_t kTruthPeriodNs = 10'000'000;    // ground truth recorded at 100 Hz
 // Seeds of the sensors' random streams, derived from the scenario seed so each is independent.
 constexpr uint64_t kCanStream = 1, kGpsStream = 2, kRtkStream = 3, kLidarStream = 4;
-
-static Eigen::Isometry3d to_isometry(const Pose2d& p) {
-  return Eigen::Translation3d(p.x, p.y, 0) * Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ());
-}
 
 Simulation::Simulation(const Scenario& scenario, const WorldDescription& description, const World& world,
                        const MaterialTable& materials, const std::string& actors_dir, int threads)
@@ -30,13 +25,8 @@ Simulation::Simulation(const Scenario& scenario, const WorldDescription& descrip
       gps_(scenario.gps, LocalFrame(description.origin), mix64(scenario.seed ^ kGpsStream)),
       rtk_(scenario.rtk, LocalFrame(description.origin), mix64(scenario.seed ^ kRtkStream)),
       control_period_ns_(kControlPeriodNs) {
-  std::map<ActorType, int> prototypes;
-  for (const auto& actor : resolved_.actors) {
-    if (!prototypes.count(actor.type))
-      prototypes[actor.type] = scene_->add_prototype(load_actor_mesh(actors_dir, actor.type, materials));
-    scene_->add_actor(prototypes[actor.type], actor_pose(actor, 0));
-  }
-  scene_->commit();
+  add_actors(*scene_, resolved_.actors, actors_dir, materials);
+  actor_poses_ = actor_motion(resolved_.actors);
   trajectory_.push_back(vehicle_.rear_axle_pose());
 }
 
@@ -94,15 +84,11 @@ void Simulation::emit_scan(StreamSink& sink) {
     return to_isometry({a.x + f * (b.x - a.x), a.y + f * (b.y - a.y),
                         a.yaw + f * std::remainder(b.yaw - a.yaw, 2 * M_PI)});
   };
-  const auto& actors = resolved_.actors;
-  const ActorPoses actor_poses = [&](int64_t t, std::vector<Eigen::Isometry3d>& out) {
-    for (size_t i = 0; i < actors.size(); ++i) out[i] = actor_pose(actors[i], t);
-  };
   const PointCloud cloud =
-      scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses);
+      scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses_);
   sink.on_scan(cloud, vehicle_pose(stamp) * scenario_.lidar.mount());
   std::vector<ActorSample> states;
-  for (const auto& a : actors) states.push_back({a.name, a.type, actor_pose2d(a, stamp)});
+  for (const auto& a : resolved_.actors) states.push_back({a.name, a.type, actor_pose2d(a, stamp)});
   sink.on_actors(stamp, states);
   ++scan_index_;
   trajectory_.erase(trajectory_.begin(), trajectory_.end() - 1);

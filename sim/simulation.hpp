@@ -71,6 +71,7 @@ class Simulation {
   CanModel can_;
   GpsModel gps_;
   RtkModel rtk_;
+  ActorPoses actor_poses_;  // empty when no actor moves
   std::function<Pose2d(int64_t, const Pose2d&)> pose_source_;
   ControllerCommand command_;
   int64_t now_ = 0;

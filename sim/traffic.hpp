@@ -9,6 +9,7 @@
 
 #include "common/vehicle_messages.hpp"
 #include "sim/actor_assets.hpp"
+#include "sim/lidar_scanner.hpp"
 #include "sim/path.hpp"
 
 namespace lidarloop {
@@ -32,5 +33,13 @@ struct ActorPlan {
 double actor_distance(const ActorPlan& plan, int64_t t_ns);
 Pose2d actor_pose2d(const ActorPlan& plan, int64_t t_ns);
 Eigen::Isometry3d actor_pose(const ActorPlan& plan, int64_t t_ns);  // footprint centre on the ground
+
+// Puts the actors into the scene (one BVH per actor type, an instance per actor, at their t = 0 poses)
+// and commits it.
+void add_actors(RayScene& scene, const std::vector<ActorPlan>& actors, const std::string& actors_dir,
+                const MaterialTable& materials);
+// Where those actors are at any time, in the order added: what the scanner asks while casting.
+// Empty when none of them moves.
+ActorPoses actor_motion(std::vector<ActorPlan> actors);
 
 }  // namespace lidarloop

@@ -87,27 +87,24 @@ void read_vehicle_params(const YamlReader& y, const YAML::Node& n, VehicleParams
                    "steering_ratio", "wheel_radius", "track_width", "max_steer", "max_steer_rate",
                    "steer_time_constant", "max_accel", "max_decel", "accel_time_constant", "max_speed",
                    "kinematic_below", "step_ns"});
-  auto num = [&](const char* key, double& v, double lo, double hi) {
-    if (n[key]) v = y.number_in(n[key], key, lo, hi);
-  };
   // Ranges: what a road vehicle from a small car to a loaded truck can have.
-  num("cornering_stiffness_front", p.cornering_stiffness_front, 1e3, 1e6);
-  num("cornering_stiffness_rear", p.cornering_stiffness_rear, 1e3, 1e6);
-  num("lf", p.lf, 0.0, 10.0);
-  num("lr", p.lr, 0.0, 10.0);
-  num("yaw_inertia", p.yaw_inertia, 100.0, 1e6);
-  num("mass", p.mass, 100.0, 1e5);
-  num("steering_ratio", p.steering_ratio, 1.0, 50.0);
-  num("wheel_radius", p.wheel_radius, 0.1, 2.0);
-  num("track_width", p.track_width, 0.5, 4.0);
-  num("max_steer", p.max_steer, 0.01, 1.2);  // below pi/2, where tan(delta) of the kinematic model blows up
-  num("max_steer_rate", p.max_steer_rate, 0.01, 10.0);
-  num("steer_time_constant", p.steer_time_constant, 0.0, 2.0);
-  num("max_accel", p.max_accel, 0.1, 20.0);
-  num("max_decel", p.max_decel, 0.1, 20.0);
-  num("accel_time_constant", p.accel_time_constant, 0.0, 2.0);
-  num("max_speed", p.max_speed, 0.5, 100.0);
-  num("kinematic_below", p.kinematic_below, kBlendWidth, 10.0);  // keeps Eq. 19 away from vx = 0
+  y.read_number(n, "cornering_stiffness_front", p.cornering_stiffness_front, 1e3, 1e6);
+  y.read_number(n, "cornering_stiffness_rear", p.cornering_stiffness_rear, 1e3, 1e6);
+  y.read_number(n, "lf", p.lf, 0.0, 10.0);
+  y.read_number(n, "lr", p.lr, 0.0, 10.0);
+  y.read_number(n, "yaw_inertia", p.yaw_inertia, 100.0, 1e6);
+  y.read_number(n, "mass", p.mass, 100.0, 1e5);
+  y.read_number(n, "steering_ratio", p.steering_ratio, 1.0, 50.0);
+  y.read_number(n, "wheel_radius", p.wheel_radius, 0.1, 2.0);
+  y.read_number(n, "track_width", p.track_width, 0.5, 4.0);
+  y.read_number(n, "max_steer", p.max_steer, 0.01, 1.2);  // below pi/2, where tan(delta) of the kinematic model blows up
+  y.read_number(n, "max_steer_rate", p.max_steer_rate, 0.01, 10.0);
+  y.read_number(n, "steer_time_constant", p.steer_time_constant, 0.0, 2.0);
+  y.read_number(n, "max_accel", p.max_accel, 0.1, 20.0);
+  y.read_number(n, "max_decel", p.max_decel, 0.1, 20.0);
+  y.read_number(n, "accel_time_constant", p.accel_time_constant, 0.0, 2.0);
+  y.read_number(n, "max_speed", p.max_speed, 0.5, 100.0);
+  y.read_number(n, "kinematic_below", p.kinematic_below, kBlendWidth, 10.0);  // keeps Eq. 19 away from vx = 0
   if (n["step_ns"]) {
     p.step_ns = y.integer_in(n["step_ns"], "step_ns", kMinStepNs, kMaxStepNs);
     // The simulation samples controller and sensors on whole milliseconds: they must fall on steps.

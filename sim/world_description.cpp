@@ -145,20 +145,17 @@ WorldDescription parse(const YamlReader& y) {
     y.allow_keys(g, {"corner_radius", "curb_top_width", "paint_width", "paint_height", "dash_length", "dash_gap",
                      "edge_line_inset", "stop_line_width", "crosswalk_stripe", "crosswalk_gap", "margin"});
     auto& p = w.geometry;
-    auto opt = [&](const char* key, double& v, double lo, double hi) {
-      if (g[key]) v = y.number_in(g[key], key, lo, hi);
-    };
-    opt("corner_radius", p.corner_radius, 0.0, 50.0);
-    opt("curb_top_width", p.curb_top_width, 0.05, 0.5);
-    opt("paint_width", p.paint_width, 0.05, 1.0);
-    opt("paint_height", p.paint_height, 0.001, 0.02);
-    opt("dash_length", p.dash_length, 0.5, 20.0);
-    opt("dash_gap", p.dash_gap, 0.5, 30.0);
-    opt("edge_line_inset", p.edge_line_inset, 0.1, 2.0);
-    opt("stop_line_width", p.stop_line_width, 0.1, 1.0);
-    opt("crosswalk_stripe", p.crosswalk_stripe, 0.2, 1.0);
-    opt("crosswalk_gap", p.crosswalk_gap, 0.2, 2.0);
-    opt("margin", p.margin, 0.0, 500.0);
+    y.read_number(g, "corner_radius", p.corner_radius, 0.0, 50.0);
+    y.read_number(g, "curb_top_width", p.curb_top_width, 0.05, 0.5);
+    y.read_number(g, "paint_width", p.paint_width, 0.05, 1.0);
+    y.read_number(g, "paint_height", p.paint_height, 0.001, 0.02);
+    y.read_number(g, "dash_length", p.dash_length, 0.5, 20.0);
+    y.read_number(g, "dash_gap", p.dash_gap, 0.5, 30.0);
+    y.read_number(g, "edge_line_inset", p.edge_line_inset, 0.1, 2.0);
+    y.read_number(g, "stop_line_width", p.stop_line_width, 0.1, 1.0);
+    y.read_number(g, "crosswalk_stripe", p.crosswalk_stripe, 0.2, 1.0);
+    y.read_number(g, "crosswalk_gap", p.crosswalk_gap, 0.2, 2.0);
+    y.read_number(g, "margin", p.margin, 0.0, 500.0);
   }
 
   RoadSpec defaults;

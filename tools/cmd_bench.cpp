@@ -58,10 +58,10 @@ static int bench_lidar(const Args& args) {
   const double yaw = std::atan2(start.linear()(1, 0), start.linear()(0, 0));
   auto place = [&](ActorType type, double ahead, double left, double heading, double speed) {
     const Eigen::Vector3d p = start * Eigen::Vector3d(ahead, left, 0);
-    return StraightActor{type, p.head<2>(), yaw + heading, speed};
+    return straight_actor(type, p.head<2>(), yaw + heading, speed);
   };
   const double lane = probe.description.roads.front().width / 4;
-  const std::vector<StraightActor> actors = {
+  const std::vector<ActorPlan> actors = {
       place(ActorType::bus, 12, -lane * 0.6, 0, 0), place(ActorType::car, 60, 2 * lane, M_PI, 10),
       place(ActorType::truck, 30, 0, 0, 8), place(ActorType::pedestrian, 20, 3 * lane, M_PI / 2, 1.4)};
   SceneSetup s = make_scene(world, actors, threads);

@@ -27,7 +27,7 @@ static int run_scan(const Args& args) {
     read_hdl32e_config(yaml, yaml.root(), config);
   }
   if (args.flag("no-motion-distortion")) config.motion_distortion = false;
-  std::vector<StraightActor> actors;
+  std::vector<ActorPlan> actors;
   for (const auto& spec : args.values("actor")) actors.push_back(parse_actor(spec));
   const auto seed = uint64_t(args.integer("seed", 1, 0, LONG_MAX));
   const double speed = args.number("speed", 0.0), yaw_rate = args.number("yaw-rate", 0.0) * kDeg;
@@ -42,7 +42,7 @@ static int run_scan(const Args& args) {
     if (!s.world.world.bounds.contains(Eigen::Vector2d(p[0], p[1])))
       throw InputError("--pose: (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ") is outside world '" +
                        s.world.world.name + "'");
-    start = planar_pose(p[0], p[1], p[2] * kDeg);
+    start = to_isometry({p[0], p[1], p[2] * kDeg});
   }
   const PoseAt trajectory = constant_twist(start, 0, speed, yaw_rate);
   const LidarScanner scanner(config, s.world.materials);

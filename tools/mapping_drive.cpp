@@ -1,7 +1,6 @@
 #include "tools/mapping_drive.hpp"
 
 #include <cmath>
-#include <map>
 #include <sstream>
 
 #include "sim/actor_assets.hpp"
@@ -16,10 +15,6 @@ namespace {
 constexpr double kTrafficSpacing = 45.0;  // m between oncoming vehicles
 constexpr double kTrafficSpeed = 9.0;     // m/s
 constexpr ActorType kTrafficTypes[] = {ActorType::car, ActorType::car, ActorType::truck, ActorType::bus};
-
-Eigen::Isometry3d to_isometry(const Pose2d& p) {
-  return Eigen::Translation3d(p.x, p.y, 0) * Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ());
-}
 
 struct LaneDrive {
   const RoadSpec* road;
@@ -71,7 +66,6 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
   double total = 0, done = 0;
   for (const auto& d : drives) total += d.path.length;
 
-  std::map<ActorType, TriangleMesh> meshes;
   for (const auto& [road, backward, path] : drives) {
     // A fresh scene per lane, with oncoming traffic on the other side of this road if asked.
     RayScene scene(world.mesh);
@@ -86,22 +80,14 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
         a.speed = kTrafficSpeed;
         traffic.push_back(a);
       }
-      std::map<ActorType, int> prototypes;
-      for (const auto& a : traffic) {
-        if (!meshes.count(a.type)) meshes[a.type] = load_actor_mesh(actors_dir, a.type, materials);
-        if (!prototypes.count(a.type)) prototypes[a.type] = scene.add_prototype(meshes[a.type]);
-        scene.add_actor(prototypes[a.type], actor_pose(a, 0));
-      }
-      scene.commit();
+      add_actors(scene, traffic, actors_dir, materials);
     }
-    const ActorPoses actor_poses = [&](int64_t t, std::vector<Eigen::Isometry3d>& out) {
-      for (size_t i = 0; i < traffic.size(); ++i) out[i] = actor_pose(traffic[i], t);
-    };
+    const ActorPoses actor_poses = actor_motion(traffic);
     const PoseAt vehicle = [&](int64_t t) { return to_isometry(path.pose_at(o.speed * double(t) * 1e-9)); };
     const int64_t scans = int64_t(path.length / o.speed / (double(period) * 1e-9));
     for (int64_t k = 0; k < scans; ++k) {
       const int64_t stamp = k * period;
-      const PointCloud cloud = scanner.scan(scene, vehicle, stamp, o.seed, traffic.empty() ? ActorPoses{} : actor_poses);
+      const PointCloud cloud = scanner.scan(scene, vehicle, stamp, o.seed, actor_poses);
       // Ground truth places each point with the pose at its own firing cycle.
       uint32_t cycle = UINT32_MAX;
       Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();

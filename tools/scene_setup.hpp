@@ -8,26 +8,23 @@
 
 #include "sim/actor_assets.hpp"
 #include "sim/lidar_scanner.hpp"
+#include "sim/traffic.hpp"
 #include "tools/world_assets.hpp"
 
 namespace lidarloop {
 
-struct StraightActor {
-  ActorType type;
-  Eigen::Vector2d start;  // footprint centre at t = 0
-  double yaw = 0;         // rad
-  double speed = 0;       // m/s along yaw
-};
+// An actor driving straight on from `start` (footprint centre at t = 0) along `yaw` at `speed`.
+ActorPlan straight_actor(ActorType type, const Eigen::Vector2d& start, double yaw, double speed);
 // "TYPE,X,Y,YAW_DEG[,SPEED]"
-StraightActor parse_actor(const std::string& spec);
+ActorPlan parse_actor(const std::string& spec);
 
 struct SceneSetup {
   LoadedWorld world;
   std::unique_ptr<RayScene> scene;
-  std::vector<StraightActor> actors;
+  std::vector<ActorPlan> actors;
   ActorPoses actor_poses;  // empty when no actor moves
 };
-SceneSetup make_scene(const std::string& world, const std::vector<StraightActor>& actors, int threads);
+SceneSetup make_scene(const std::string& world, const std::vector<ActorPlan>& actors, int threads);
 
 // Limits TBB (our loops) to `threads` for as long as it lives.
 std::unique_ptr<tbb::global_control> limit_threads(int threads);

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "common/input_error.hpp"
+#include "sim/path.hpp"
 
 namespace lidarloop {
 
@@ -33,25 +34,8 @@ LoadedWorld load_world(const std::string& name_or_path) {
   return {std::move(materials), std::move(description), std::move(world)};
 }
 
-}  // namespace lidarloop
-
-#include "sim/polyline.hpp"
-
-namespace lidarloop {
-
-Eigen::Isometry3d planar_pose(double x, double y, double yaw) {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translate(Eigen::Vector3d(x, y, 0));
-  pose.rotate(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
-  return pose;
-}
-
 Eigen::Isometry3d default_start_pose(const WorldDescription& description, double s) {
-  const RoadSpec& road = description.roads.front();
-  const PolylineSample at = sample_polyline(road.centreline, s);
-  const double lane_offset = road.one_way ? 0.0 : -road.width / 4;
-  const Eigen::Vector2d p = at.point + Eigen::Vector2d(at.tangent.y(), -at.tangent.x()) * -lane_offset;
-  return planar_pose(p.x(), p.y(), std::atan2(at.tangent.y(), at.tangent.x()));
+  return to_isometry(lane_path(description.roads.front(), Lane::right, false).pose_at(s));
 }
 
 }  // namespace lidarloop

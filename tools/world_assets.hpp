@@ -20,11 +20,7 @@ struct LoadedWorld {
 };
 LoadedWorld load_world(const std::string& name_or_path);
 
-}  // namespace lidarloop
-
-namespace lidarloop {
 // A sensible place to put a car: `s` metres along the first road, in the right-hand lane, heading along it.
 Eigen::Isometry3d default_start_pose(const WorldDescription& description, double s = 20.0);
-// Vehicle pose from x, y (m) and yaw (rad) on the ground plane.
-Eigen::Isometry3d planar_pose(double x, double y, double yaw);
+
 }  // namespace lidarloop
