@@ -23,7 +23,7 @@ YamlReader YamlReader::open(const std::string& path) {
 
 YamlReader YamlReader::from_string(const std::string& text, std::string name) {
   try {
-    return YamlReader(name, YAML::Load(text));
+    return YamlReader(name, text, YAML::Load(text));
   } catch (const YAML::Exception& e) {
     throw InputError(name + ":" + std::to_string(e.mark.line + 1) + ":" +
                      std::to_string(e.mark.column + 1) + ": YAML syntax error: " + e.msg);

@@ -20,6 +20,7 @@ class YamlReader {
 
   const YAML::Node& root() const { return root_; }
   const std::string& file() const { return file_; }
+  const std::string& text() const { return text_; }  // the YAML as read (for attachments in logs)
 
   [[noreturn]] void fail(const YAML::Node& at, const std::string& message) const;
 
@@ -41,8 +42,9 @@ class YamlReader {
   Eigen::Vector3d vec3(const YAML::Node& node, std::string_view what) const;
 
  private:
-  YamlReader(std::string file, YAML::Node root) : file_(std::move(file)), root_(std::move(root)) {}
-  std::string file_;
+  YamlReader(std::string file, std::string text, YAML::Node root)
+      : file_(std::move(file)), text_(std::move(text)), root_(std::move(root)) {}
+  std::string file_, text_;
   YAML::Node root_;
 };
 

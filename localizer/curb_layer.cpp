@@ -28,9 +28,17 @@ CurbLayer::CurbLayer(const CurbMap& map, double spacing) : map_(map) {
   for (const auto& line : map_.curbs)
     for (size_t i = 1; i < line.size(); ++i) {
       const Eigen::Vector2d d = line[i] - line[i - 1];
-      const int steps = std::max(1, int(std::ceil(d.norm() / spacing)));
-      for (int k = 0; k < steps; ++k) points_.push_back(line[i - 1] + d * (double(k) / steps));
-      if (i + 1 == line.size()) points_.push_back(line[i]);
+      const double length = d.norm();
+      if (length == 0) continue;
+      const int steps = std::max(1, int(std::ceil(length / spacing)));
+      for (int k = 0; k < steps; ++k) {
+        points_.push_back(line[i - 1] + d * (double(k) / steps));
+        tangents_.push_back(d / length);
+      }
+      if (i + 1 == line.size()) {
+        points_.push_back(line[i]);
+        tangents_.push_back(d / length);
+      }
     }
   index_ = std::make_unique<Index>(&points_);
 }
@@ -42,12 +50,16 @@ CurbLayer CurbLayer::load(const std::string& geojson_path, double spacing) {
 CurbLayer::~CurbLayer() = default;
 // The index reads the points through a pointer to the member vector: re-aim it after a move.
 CurbLayer::CurbLayer(CurbLayer&& other) noexcept
-    : map_(std::move(other.map_)), points_(std::move(other.points_)), index_(std::move(other.index_)) {
+    : map_(std::move(other.map_)),
+      points_(std::move(other.points_)),
+      tangents_(std::move(other.tangents_)),
+      index_(std::move(other.index_)) {
   if (index_) index_->adaptor.points = &points_;
 }
 CurbLayer& CurbLayer::operator=(CurbLayer&& other) noexcept {
   map_ = std::move(other.map_);
   points_ = std::move(other.points_);
+  tangents_ = std::move(other.tangents_);
   index_ = std::move(other.index_);
   if (index_) index_->adaptor.points = &points_;
   return *this;

@@ -24,6 +24,9 @@ class CurbLayer {
 
   const CurbMap& map() const { return map_; }
   const std::vector<Eigen::Vector2d>& points() const { return points_; }
+  // Unit direction of the curb line at each point (of the segment it was sampled from): what a
+  // point-to-line residual needs to know which way a curb constrains the pose.
+  const std::vector<Eigen::Vector2d>& tangents() const { return tangents_; }
 
   // Curb points inside the axis-aligned square of half size `half_extent` around `centre`.
   std::vector<Eigen::Vector2d> window(const Eigen::Vector2d& centre, double half_extent) const;
@@ -33,7 +36,7 @@ class CurbLayer {
  private:
   struct Index;
   CurbMap map_;
-  std::vector<Eigen::Vector2d> points_;
+  std::vector<Eigen::Vector2d> points_, tangents_;
   std::unique_ptr<Index> index_;
 };
 

@@ -15,31 +15,48 @@ static Eigen::Isometry3d arc_pose(const ScanMotion& m, double t) {
   return Eigen::Translation3d(x, y, 0) * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ());
 }
 
-std::vector<Eigen::Vector3d> deskew(const PointCloud& cloud, const Eigen::Isometry3d& mount, const ScanMotion& motion,
-                                    int64_t reference_ns) {
+static void reserve(ScanPoints& s, size_t n) {
+  s.xyz.reserve(n);
+  s.ring.reserve(n);
+  s.intensity.reserve(n);
+}
+
+static void append(ScanPoints& s, const Eigen::Vector3d& xyz, const LidarPoint& p) {
+  s.xyz.push_back(xyz);
+  s.ring.push_back(p.ring);
+  s.intensity.push_back(p.intensity);
+}
+
+ScanPoints deskew(const PointCloud& cloud, const Eigen::Isometry3d& mount, const ScanMotion& motion, int64_t reference_ns) {
   const Eigen::Isometry3d reference_inverse = arc_pose(motion, double(reference_ns) * 1e-9).inverse();
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(cloud.points.size());
+  ScanPoints out;
+  reserve(out, cloud.points.size());
   uint32_t last_t = UINT32_MAX;
   Eigen::Isometry3d to_reference = Eigen::Isometry3d::Identity();
   for (const LidarPoint& p : cloud.points) {
     const Eigen::Vector3d q(p.x, p.y, p.z);
-    if (!q.allFinite()) continue;
+    if (!q.allFinite()) {
+      ++out.dropped;
+      continue;
+    }
     if (p.t_ns != last_t) {  // points come in firing order: one pose per firing time
       to_reference = reference_inverse * arc_pose(motion, double(p.t_ns) * 1e-9) * mount;
       last_t = p.t_ns;
     }
-    out.push_back(to_reference * q);
+    append(out, to_reference * q, p);
   }
   return out;
 }
 
-std::vector<Eigen::Vector3d> to_vehicle_frame(const PointCloud& cloud, const Eigen::Isometry3d& mount) {
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(cloud.points.size());
+ScanPoints to_vehicle_frame(const PointCloud& cloud, const Eigen::Isometry3d& mount) {
+  ScanPoints out;
+  reserve(out, cloud.points.size());
   for (const LidarPoint& p : cloud.points) {
     const Eigen::Vector3d q(p.x, p.y, p.z);
-    if (q.allFinite()) out.push_back(mount * q);
+    if (q.allFinite())
+      append(out, mount * q, p);
+    else
+      ++out.dropped;
   }
   return out;
 }

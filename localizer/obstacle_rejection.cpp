@@ -68,24 +68,34 @@ double distance_to_plane(const Plane& plane, const Eigen::Vector3d& p) {
 ObstacleSplit reject_obstacles(const std::vector<Eigen::Vector3d>& corridor_points, const ObstacleParams& params) {
   ObstacleSplit out;
   std::vector<Eigen::Vector3d> pts;
+  std::vector<size_t> index;
   pts.reserve(corridor_points.size());
-  for (const auto& p : corridor_points)
-    if (finite(p)) pts.push_back(p);
+  index.reserve(corridor_points.size());
+  for (size_t i = 0; i < corridor_points.size(); ++i)
+    if (finite(corridor_points[i])) {
+      pts.push_back(corridor_points[i]);
+      index.push_back(i);
+    }
 
   const auto plane = fit_ground_plane(pts, params.ground_fraction);
   if (!plane) {
     out.ground = std::move(pts);
+    out.ground_index = std::move(index);
     return out;
   }
   out.plane = *plane;
   out.plane_ok = true;
   out.ground.reserve(pts.size());
-  for (const auto& p : pts) {
+  out.ground_index.reserve(pts.size());
+  for (size_t k = 0; k < pts.size(); ++k) {
     // Eq. 3 with the sign kept: d_i > d_sigma and above the plane (see the header for why).
-    if (height_above_plane(*plane, p) > params.obstacle_distance)
-      out.obstacles.push_back(p);
-    else
-      out.ground.push_back(p);
+    if (height_above_plane(*plane, pts[k]) > params.obstacle_distance) {
+      out.obstacles.push_back(pts[k]);
+      out.obstacle_index.push_back(index[k]);
+    } else {
+      out.ground.push_back(pts[k]);
+      out.ground_index.push_back(index[k]);
+    }
   }
   return out;
 }

@@ -35,6 +35,8 @@ double height_above_plane(const Plane& plane, const Eigen::Vector3d& p);
 
 struct ObstacleSplit {
   std::vector<Eigen::Vector3d> ground, obstacles;
+  // Where each ground / obstacle point sits in the input, so callers can carry per-point data along.
+  std::vector<size_t> ground_index, obstacle_index;
   Plane plane;
   bool plane_ok = false;
 };

@@ -29,6 +29,7 @@ class MotionPredictor {
   explicit MotionPredictor(const VehicleModelParams& params) : p_(params) {}
   // Advances the pose (rear axle, local frame) by dt with speed v and front wheel angle delta.
   Pose2d predict(const Pose2d& pose, double v, double delta, double dt);
+  double yaw_rate() const { return yaw_rate_; }  // rad/s, as of the last step
 
  private:
   VehicleModelParams p_;
@@ -53,6 +54,8 @@ class PoseFilter {
   // KF2: the curb matching observation (x_c, y_c, psi_c) and the intensity one (x_s, y_s).
   void update_curb(const Eigen::Vector3d& z, const Eigen::Matrix3d& R);
   void update_intensity(const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  // Uncertainty the motion model does not know about (dead reckoning without CAN): P += Q.
+  void inflate(const Eigen::Matrix3d& Q) { P_ += Q; }
 
   Pose2d pose() const { return {x_.x(), x_.y(), x_.z()}; }
   const Eigen::Matrix3d& covariance() const { return P_; }

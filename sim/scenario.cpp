@@ -196,6 +196,7 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
                       "loop", "pass", "output"});
   Scenario s;
   s.file = y.file();
+  s.text = y.text();
   s.world = y.string(y.required(root, "world"), "world");
   s.duration_s = y.number_in(y.required(root, "duration_s"), "duration_s", 0.1, kMaxDuration);
   if (root["seed"]) s.seed = uint64_t(y.integer_in(root["seed"], "seed", 0, (1L << 62)));
@@ -210,7 +211,6 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
   }
   if (const YAML::Node l = root["localizer"]) {
     y.expect_map(l, "localizer");
-    y.allow_keys(l, {"method"});
     if (l["method"]) {
       s.localizer_method = y.string(l["method"], "method");
       const auto& m = localizer_methods();

@@ -65,6 +65,7 @@ struct PassThresholds {
 
 struct Scenario {
   std::string file;
+  std::string text;                    // the YAML as read: recorded with logs, re-read for `localizer`
   std::string world = "campus";        // a name under maps/ or a path
   double duration_s = 60;
   uint64_t seed = 1;
@@ -74,6 +75,8 @@ struct Scenario {
   GpsConfig gps;
   RtkConfig rtk;
   std::vector<TrafficSpec> traffic;
+  // `localizer`: the method here; the rest of the section (parameter overrides) belongs to the
+  // localizer and is read by the tools from `text`, since sim/ does not know the localizer.
   std::string localizer_method = "proposed";
   bool closed_loop = false;
   PassThresholds pass;

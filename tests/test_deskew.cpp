@@ -34,7 +34,7 @@ double wall_spread(bool compensate, double speed, double yaw_rate) {
     const bool early = p.t_ns < 2'000'000, late = int64_t(p.t_ns) > end - 2'000'000;
     if (!early && !late) continue;
     // The wall's face is the world plane x = 24.5: compare in the world through the end pose.
-    const Eigen::Vector3d world = end_pose * points[i];
+    const Eigen::Vector3d world = end_pose * points.xyz[i];
     lo = std::min(lo, world.x()), hi = std::max(hi, world.x());
   }
   return hi - lo;

@@ -34,6 +34,15 @@ void write_birdseye_png(const std::string& path, const PointCloud& cloud, const 
     for (size_t i = 1; i < line.size(); ++i)
       cv::line(image, pixel(line[i - 1]), pixel(line[i]), cv::Scalar(80, 220, 80), 1, cv::LINE_AA);
 
+  for (const auto& m : o.marks)
+    for (const auto& p : m.points) cv::circle(image, pixel(p), 2, cv::Scalar(m.bgr[0], m.bgr[1], m.bgr[2]), -1, cv::LINE_AA);
+  constexpr double kArrowLength = 4.0;  // m
+  for (const auto& p : o.poses) {
+    const Eigen::Vector2d from(p.pose.x, p.pose.y);
+    const Eigen::Vector2d to = from + kArrowLength * Eigen::Vector2d(std::cos(p.pose.yaw), std::sin(p.pose.yaw));
+    cv::arrowedLine(image, pixel(from), pixel(to), cv::Scalar(p.bgr[0], p.bgr[1], p.bgr[2]), 2, cv::LINE_AA, 0, 0.3);
+  }
+
   // The sensor and its heading.
   const Eigen::Vector2d ahead = centre + sensor_pose.linear().col(0).head<2>().normalized() * 4.0;
   cv::arrowedLine(image, pixel(centre), pixel(ahead), cv::Scalar(255, 255, 255), 2, cv::LINE_AA, 0, 0.3);
@@ -41,8 +50,23 @@ void write_birdseye_png(const std::string& path, const PointCloud& cloud, const 
   const int bar = int(std::lround(10.0 / o.metres_per_pixel));
   cv::line(image, {20, size - 20}, {20 + bar, size - 20}, cv::Scalar(255, 255, 255), 2);
   cv::putText(image, "10 m", {20, size - 28}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-  cv::putText(image, std::to_string(cloud.points.size()) + " points, curbs in green, north up", {20, 24},
-              cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  const cv::Scalar white(255, 255, 255);
+  const std::string title = o.title.empty() ? std::to_string(cloud.points.size()) + " points" : o.title;
+  cv::putText(image, title + ", map curbs in green, north up", {20, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.5, white, 1,
+              cv::LINE_AA);
+  // A legend line per mark layer and pose, in its colour.
+  int y = 46;
+  constexpr int kLineStep = 20;
+  for (const auto& m : o.marks) {
+    cv::putText(image, m.label, {20, y}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(m.bgr[0], m.bgr[1], m.bgr[2]), 1,
+                cv::LINE_AA);
+    y += kLineStep;
+  }
+  for (const auto& p : o.poses) {
+    cv::putText(image, p.label, {20, y}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(p.bgr[0], p.bgr[1], p.bgr[2]), 1,
+                cv::LINE_AA);
+    y += kLineStep;
+  }
   if (!cv::imwrite(path, image)) throw InputError(path + ": cannot write PNG");
 }
 

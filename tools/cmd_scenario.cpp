@@ -7,6 +7,7 @@
 
 #include "tools/commands.hpp"
 #include "tools/csv_streams.hpp"
+#include "tools/localizer_setup.hpp"
 #include "tools/scene_setup.hpp"
 #include "tools/world_map_png.hpp"
 
@@ -14,22 +15,9 @@ namespace lidarloop {
 
 namespace {
 
-struct LoadedScenario {
-  Scenario scenario;
-  LoadedWorld world;
-  ResolvedScenario resolved;
-};
-
-LoadedScenario load(const std::string& path) {
-  Scenario scenario = load_scenario(path, load_vehicle_params(data_dir() + "/assets/vehicle.yaml"));
-  LoadedWorld world = load_world(scenario.world);
-  ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
-  return {std::move(scenario), std::move(world), std::move(resolved)};
-}
-
 int run_validate(const Args& args) {
   for (const auto& file : args.positional()) {
-    const LoadedScenario s = load(file);
+    const LoadedScenario s = load_scenario_and_world(file);
     std::cout << file << ": ok (world " << s.world.world.name << ", " << s.scenario.duration_s << " s, route "
               << int(s.resolved.ego_route.length) << " m, " << s.resolved.actors.size() << " traffic actors)\n";
   }
@@ -39,7 +27,7 @@ int run_validate(const Args& args) {
 int run_simulate(const Args& args) {
   const int threads = thread_count(args);
   const auto limit = limit_threads(threads);
-  LoadedScenario s = load(args.positional().at(0));
+  LoadedScenario s = load_scenario_and_world(args.positional().at(0));
   if (auto seed = args.value("seed")) s.scenario.seed = uint64_t(args.integer("seed", 0, 0, 1L << 62));
   if (args.value("duration")) s.scenario.duration_s = args.number("duration", s.scenario.duration_s);
   if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");

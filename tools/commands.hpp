@@ -17,7 +17,11 @@ Command bench_command();
 Command validate_command();
 Command simulate_command();
 Command map_command();
+Command run_command();
+Command compare_command();
 int run_bench_map(const Args& args);
+int run_bench_localizer(const Args& args);
+int run_bench_loop(const Args& args);
 
 // --threads N: 0 means all cores. Returns the effective count.
 int thread_count(const Args& args);

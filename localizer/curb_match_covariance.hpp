@@ -1,0 +1,43 @@
+#pragma once
+// How well a curb match pins the pose down, for the Kalman filter's curb observation (paper 3.3).
+// Point-to-point ICP (Eq. 9) finds the transform but says nothing about its uncertainty, and the
+// uncertainty is very anisotropic: curbs along a straight road fix the lateral position and the heading
+// but leave the longitudinal free (DESIGN.md; the reason the intensity layer exists). Each matched curb
+// constrains the pose only across its map curb line, so the information of the match is the sum of
+// point-to-line Jacobians, and its inverse is the observation covariance.
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/vehicle_messages.hpp"
+#include "localizer/probabilistic_icp.hpp"
+
+namespace lidarloop {
+
+struct CurbMatchNoise {
+  // Across-curb noise of one curb feature (m). Larger than the detector's centimetres: the features of
+  // one scan are not independent (the accumulated frames share odometry errors, neighbouring curbs share
+  // the map's digitising error), and this is the simple way to say so.
+  double point_sigma_m = 0.2;
+  double inlier_distance_m = 1.0;  // features farther from the map than this carry no information (d_g)
+  // Floors, so that a perfect-looking match is never trusted beyond what a map can be trusted.
+  double min_sigma_m = 0.03;
+  double min_sigma_yaw_rad = 0.002;
+  // A direction without any curb information gets this standard deviation rather than an infinite one
+  // (an observation with a huge variance leaves the filter's estimate there as it was).
+  double unconstrained_sigma_m = 100.0;
+};
+
+struct CurbMatchQuality {
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // of (x, y, psi), local frame
+  size_t inliers = 0;
+  double inlier_ratio = 0;
+};
+
+// curbs_vehicle: the curb features in the vehicle frame; pose: the matched pose. The map's points and
+// unit tangents (CurbLayer::tangents) index as `map`'s points.
+CurbMatchQuality curb_match_quality(const std::vector<Eigen::Vector2d>& curbs_vehicle, const Pose2d& pose,
+                                    const MapIndex& map, const std::vector<Eigen::Vector2d>& map_tangents,
+                                    const CurbMatchNoise& noise);
+
+}  // namespace lidarloop

@@ -1,0 +1,337 @@
+#include "localizer/localizer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+#include "localizer/aps_matcher.hpp"
+#include "localizer/curb_detector.hpp"
+#include "localizer/curb_match_covariance.hpp"
+#include "localizer/deskew.hpp"
+#include "localizer/driving_corridor.hpp"
+#include "localizer/obstacle_rejection.hpp"
+
+namespace lidarloop {
+namespace {
+
+constexpr double kNsPerS = 1e9;
+// Before the first fix there is no pose: the estimate says so with this (m^2, rad^2) on the diagonal.
+constexpr double kUnknownVariance = 1e6;
+
+class Stopwatch {
+ public:
+  double lap_ms() {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+    return ms;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+Eigen::Vector2d xy(const Pose2d& p) { return {p.x, p.y}; }
+
+Eigen::Vector2d to_world(const Pose2d& pose, const Eigen::Vector2d& p) {
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  return {pose.x + c * p.x() - s * p.y(), pose.y + s * p.x() + c * p.y()};
+}
+
+// b's pose relative to a, in a's frame.
+Odometry2d relative(const Pose2d& a, const Pose2d& b) {
+  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  return {c * dx + s * dy, -s * dx + c * dy, wrap_angle(b.yaw - a.yaw)};
+}
+
+Pose2d compose(const Pose2d& a, const Odometry2d& d) {
+  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
+  return {a.x + c * d.dx - s * d.dy, a.y + s * d.dx + c * d.dy, wrap_angle(a.yaw + d.dpsi)};
+}
+
+}  // namespace
+
+std::string describe_health(uint32_t flags) {
+  static const std::array<const char*, kHealthFlagCount> names = {
+      "not initialised", "CAN gap",        "no GPS",           "invalid points",     "empty scan",
+      "no corridor",     "no ground plane", "few curbs",        "curb match rejected", "no intensity match",
+      "intensity match rejected"};
+  if (flags == 0) return "ok";
+  std::string out;
+  for (int i = 0; i < kHealthFlagCount; ++i)
+    if (flags & (1u << i)) out += (out.empty() ? "" : ", ") + std::string(names[size_t(i)]);
+  return out;
+}
+
+const char* stage_name(Stage s) {
+  static const std::array<const char*, kStageCount> names = {
+      "deskew", "corridor", "obstacles", "curb_detection", "curb_features", "curb_matching", "intensity_matching",
+      "fusion"};
+  return names[size_t(s)];
+}
+
+Localizer::Localizer(HdMap& map, const LocalizerParams& params)
+    : map_(map),
+      params_(params),
+      frame_(map.curbs.map().origin),
+      map_index_(map.curbs.points()),
+      rng_(params.seed),
+      predictor_(params.vehicle),
+      accumulator_(params.curb_features.frames) {}
+
+void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance) {
+  predict_to(stamp_ns);
+  filter_.emplace(pose, covariance, params_.filter);
+}
+
+std::optional<Pose2d> Localizer::pose() const {
+  if (!filter_) return std::nullopt;
+  return filter_->pose();
+}
+
+void Localizer::predict_to(int64_t t_ns) {
+  if (t_ns <= time_ns_) return;
+  const Pose2d before = odometry_;
+  const double dt = double(t_ns - time_ns_) / kNsPerS;
+  const int64_t max_step_ns = std::max<int64_t>(1, int64_t(params_.max_prediction_step_s * kNsPerS));
+  while (time_ns_ < t_ns) {
+    const int64_t h = std::min(max_step_ns, t_ns - time_ns_);
+    odometry_ = predictor_.predict(odometry_, speed_, steer_, double(h) / kNsPerS);  // Eq. 19 (Euler)
+    time_ns_ += h;
+  }
+  if (!filter_) return;
+  // The filter moves by the odometry's increment in its own frame.
+  const Odometry2d step = relative(before, odometry_);
+  filter_->predict(compose(filter_->pose(), step), std::hypot(step.dx, step.dy), dt);
+  const bool can_stale =
+      !last_can_ns_ || double(t_ns - *last_can_ns_) / kNsPerS > params_.health.can_timeout_s;
+  if (can_stale) {
+    const double q = params_.process_position_without_can_per_s;
+    filter_->inflate(Eigen::Vector3d(q * q * dt, q * q * dt, 0).asDiagonal());
+  }
+}
+
+void Localizer::on_can(const CanFrame& f) {
+  if (last_can_ns_ && f.stamp_ns < *last_can_ns_) return;  // out of order: stale news
+  const double speed = 0.5 * (f.wheel_speed_mps[2] + f.wheel_speed_mps[3]);  // rear axle centre
+  const double steer = f.steering_wheel_angle_rad / params_.vehicle.steering_ratio;
+  if (!std::isfinite(speed) || !std::isfinite(steer)) return;
+  predict_to(f.stamp_ns);  // with the previous frame's values, held until now
+  speed_ = speed;
+  steer_ = steer;
+  last_can_ns_ = f.stamp_ns;
+}
+
+void Localizer::on_gps(const GpsFix& fix) {
+  if (fix.status == GpsStatus::no_fix) return;
+  if (!std::isfinite(fix.lat_deg) || !std::isfinite(fix.lon_deg) || !std::isfinite(fix.heading_rad)) return;
+  predict_to(fix.stamp_ns);
+  const Eigen::Vector2d p = frame_.to_local(fix.lat_deg, fix.lon_deg);
+  const GpsNoise& n = params_.gps_noise;
+  auto variance = [&](double reported, double floor) {
+    const double v = std::isfinite(reported) ? std::max(reported, floor * floor) : floor * floor;
+    return v * n.variance_scale;
+  };
+  const Eigen::Matrix3d R = Eigen::Vector3d(variance(fix.position_covariance[0], n.min_sigma_m),
+                                            variance(fix.position_covariance[4], n.min_sigma_m),
+                                            variance(fix.heading_variance, n.min_heading_sigma_rad))
+                                .asDiagonal();
+  last_gps_ns_ = fix.stamp_ns;
+  if (!filter_) {
+    filter_.emplace(Pose2d{p.x(), p.y(), wrap_angle(fix.heading_rad)}, R, params_.filter);
+    return;
+  }
+  filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R);  // KF1
+}
+
+uint32_t Localizer::input_health(int64_t t_ns) const {
+  uint32_t flags = 0;
+  if (!last_can_ns_ || double(t_ns - *last_can_ns_) / kNsPerS > params_.health.can_timeout_s) flags |= kCanGap;
+  if (!last_gps_ns_ || double(t_ns - *last_gps_ns_) / kNsPerS > params_.health.gps_timeout_s) flags |= kNoGps;
+  return flags;
+}
+
+bool Localizer::gate(double mahalanobis_sq, double threshold, int& rejections) const {
+  if (std::isfinite(mahalanobis_sq) && mahalanobis_sq <= threshold) {
+    rejections = 0;
+    return true;
+  }
+  if (++rejections > params_.health.max_rejections) {
+    rejections = 0;
+    return std::isfinite(mahalanobis_sq);
+  }
+  return false;
+}
+
+LocalizerEstimate Localizer::on_scan(const PointCloud& cloud) {
+  Stopwatch total, watch;
+  LocalizerEstimate e;
+  uint32_t last_t = 0;
+  for (const LidarPoint& p : cloud.points) last_t = std::max(last_t, p.t_ns);
+  e.stamp_ns = std::max(cloud.stamp_ns + int64_t(last_t), time_ns_);
+  predict_to(e.stamp_ns);
+  e.health = input_health(e.stamp_ns);
+  const Odometry2d since_previous =
+      previous_scan_odometry_ ? relative(*previous_scan_odometry_, odometry_) : Odometry2d{};
+  previous_scan_odometry_ = odometry_;
+  features_ = {};
+
+  auto finish = [&]() {
+    if (filter_) {
+      e.pose = filter_->pose();
+      e.covariance = filter_->covariance();
+    } else {
+      e.health |= kNotInitialized;
+      e.covariance = Eigen::Matrix3d::Identity() * kUnknownVariance;
+    }
+    e.total_ms = total.lap_ms();
+    return e;
+  };
+  const LocalizerMethod method = params_.method;
+  if (method == LocalizerMethod::gps) return finish();
+
+  const ScanPoints points =
+      params_.deskew ? deskew(cloud, params_.lidar_mount, {speed_, predictor_.yaw_rate()}, int64_t(last_t))
+                     : to_vehicle_frame(cloud, params_.lidar_mount);
+  e.points = points.size();
+  e.dropped_points = points.dropped;
+  if (points.dropped > 0) e.health |= kInvalidPoints;
+  e.stage_ms[size_t(Stage::deskew)] = watch.lap_ms();
+  if (e.points < size_t(std::max(params_.health.min_scan_points, 1)) || !filter_) {
+    if (e.points < size_t(std::max(params_.health.min_scan_points, 1))) e.health |= kEmptyScan;
+    accumulator_.add({}, since_previous);  // keep the older frames where they are relative to the car
+    return finish();
+  }
+  const Pose2d prior = filter_->pose();
+
+  // 2.1: the driving corridor, and the ground and obstacles inside it.
+  std::vector<size_t> ground;  // indices into points
+  std::vector<Eigen::Vector2d> obstacles;
+  if (removes_obstacles(method)) {
+    const CorridorParams& cp = params_.corridor;
+    const double half = 0.5 * std::max(cp.width_cells, cp.height_cells) * cp.cell_m;
+    const DrivingCorridor corridor = extract_driving_corridor(map_.curbs.window(xy(prior), half), prior, cp);
+    std::vector<size_t> inside;
+    std::vector<Eigen::Vector3d> inside_xyz;
+    const bool have_corridor = !corridor.mask.empty();
+    if (!have_corridor) e.health |= kNoCorridor;
+    for (size_t i = 0; i < points.size(); ++i)
+      if (!have_corridor || corridor.contains(points.xyz[i].head<2>())) {
+        inside.push_back(i);
+        inside_xyz.push_back(points.xyz[i]);
+      }
+    e.corridor_points = inside.size();
+    e.stage_ms[size_t(Stage::corridor)] = watch.lap_ms();
+    const ObstacleSplit split = reject_obstacles(inside_xyz, params_.obstacles);
+    if (!split.plane_ok) e.health |= kNoGroundPlane;
+    for (size_t k : split.ground_index) ground.push_back(inside[k]);
+    for (const auto& o : split.obstacles) obstacles.push_back(o.head<2>());
+    e.obstacle_points = obstacles.size();
+    e.stage_ms[size_t(Stage::obstacles)] = watch.lap_ms();
+  }
+  features_.obstacles = obstacles;
+
+  // 2.2.1 and 3.1: curbs.
+  if (uses_curbs(method)) {
+    std::vector<Eigen::Vector2d> curbs = detect_curbs(points.xyz, points.ring, params_.curb_detector);
+    e.curbs_detected = curbs.size();
+    e.stage_ms[size_t(Stage::curb_detection)] = watch.lap_ms();
+    if (removes_obstacles(method))
+      curbs = reject_near_obstacles(curbs, obstacles, params_.curb_features.obstacle_distance);
+    accumulator_.add(curbs, since_previous);  // Eq. 4-5
+    std::vector<Eigen::Vector2d> features =
+        beam_model(accumulator_.curbs(), accumulator_.launch_points(), params_.curb_features);  // Eq. 6-7
+    e.curb_features = features.size();
+    e.stage_ms[size_t(Stage::curb_features)] = watch.lap_ms();
+    match_curbs(features, e);
+    features_.curbs = std::move(features);
+  }
+
+  // 2.2.2 and 3.2: intensity.
+  if (uses_intensity(method)) {
+    std::vector<Eigen::Vector3d> ground_xyz;
+    std::vector<double> intensities;
+    ground_xyz.reserve(ground.size());
+    intensities.reserve(ground.size());
+    for (size_t i : ground) {
+      ground_xyz.push_back(points.xyz[i]);
+      intensities.push_back(points.intensity[i]);
+    }
+    match_intensity(ground_xyz, intensities, e);
+  }
+  return finish();
+}
+
+void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, LocalizerEstimate& e) {
+  Stopwatch watch;
+  if (features.size() < size_t(params_.health.min_curbs)) {
+    e.health |= kFewCurbs;
+    return;
+  }
+  const Pose2d prior = filter_->pose();
+  std::vector<Eigen::Vector2d> world;
+  world.reserve(features.size());
+  for (const auto& f : features) world.push_back(to_world(prior, f));
+
+  Transform2d t;
+  switch (params_.method) {
+    case LocalizerMethod::proposed:
+      t = probabilistic_icp(map_index_, world, {}, params_.probabilistic_icp, rng_).t;
+      break;
+    case LocalizerMethod::icp:
+    case LocalizerMethod::icp_obs:
+      t = icp(map_index_, world, {}, params_.icp).t;
+      break;
+    case LocalizerMethod::m_icp:
+      t = m_icp(map_index_, world, {}, params_.m_icp).t;
+      break;
+    default:
+      return;
+  }
+  const Eigen::Vector2d corrected_xy = t.apply(xy(prior));
+  const Pose2d z{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t.theta)};
+  const CurbMatchQuality q = curb_match_quality(features, z, map_index_, map_.curbs.tangents(), params_.curb_noise);
+  e.curb_observation = z;
+  e.curb_inlier_ratio = q.inlier_ratio;
+  e.stage_ms[size_t(Stage::curb_matching)] += watch.lap_ms();
+  if (q.inlier_ratio < params_.health.min_inlier_ratio) {
+    e.health |= kCurbMatchRejected;
+    return;
+  }
+  Eigen::Vector3d innovation(z.x - prior.x, z.y - prior.y, wrap_angle(z.yaw - prior.yaw));
+  const Eigen::Matrix3d S = filter_->covariance() + q.covariance;
+  if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_curb, curb_rejections_)) {
+    e.health |= kCurbMatchRejected;
+    return;
+  }
+  filter_->update_curb(Eigen::Vector3d(z.x, z.y, z.yaw), q.covariance);  // KF2
+  e.stage_ms[size_t(Stage::fusion)] += watch.lap_ms();
+}
+
+void Localizer::match_intensity(const std::vector<Eigen::Vector3d>& ground, const std::vector<double>& intensities,
+                                LocalizerEstimate& e) {
+  Stopwatch watch;
+  const IntensityGrid S = build_intensity_grid(ground, intensities, filter_->pose(), params_.intensity_grid);  // Eq. 8
+  const ApsResult aps = aps_match(S, map_.intensity, params_.aps);  // Eq. 14-18
+  e.intensity_cells = aps.cells_used;
+  e.stage_ms[size_t(Stage::intensity_matching)] += watch.lap_ms();
+  if (!aps.ok) {
+    e.health |= kNoIntensityMatch;
+    return;
+  }
+  e.intensity_observation = aps.position;
+  const Pose2d prior = filter_->pose();
+  const Eigen::Vector2d innovation = aps.position - xy(prior);
+  const Eigen::Matrix2d S2 = filter_->covariance().topLeftCorner<2, 2>() + aps.covariance;
+  if (!gate(innovation.dot(S2.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
+    e.health |= kIntensityMatchRejected;
+    return;
+  }
+  filter_->update_intensity(aps.position, aps.covariance);  // KF2
+  e.stage_ms[size_t(Stage::fusion)] += watch.lap_ms();
+}
+
+}  // namespace lidarloop

@@ -1,0 +1,125 @@
+#pragma once
+// The localizer as a car runs it: messages in, estimates out. Feed CAN frames, GPS fixes and LiDAR
+// scans in time order; every scan yields an estimate of the pose at the scan's end, with its covariance
+// and a health status. The runner, replay, benchmarks and tests all drive this one class.
+//
+// Per scan (paper sections 2-3, method `proposed`):
+//   predict to the scan's end with Eq. 19 from CAN -> de-skew the points with CAN odometry ->
+//   driving corridor from the curb map (2.1.1) -> ground plane and obstacles (2.1.2, Eq. 2-3) ->
+//   single-frame curbs, accumulated over frames (Eq. 4-5), minus those next to obstacles, beam model
+//   (Eq. 6-7) -> probabilistic ICP against the map (3.1) -> KF2 curb update (x, y, psi) ->
+//   grid S of the ground's intensities (Eq. 8) -> APS against the intensity layer (3.2) -> KF2
+//   intensity update (x, y).
+// GPS fixes update KF1 as they come. The baselines swap or drop the matching steps (LocalizerMethod).
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/geodetic.hpp"
+#include "common/point_cloud.hpp"
+#include "common/vehicle_messages.hpp"
+#include "localizer/curb_features.hpp"
+#include "localizer/hd_map.hpp"
+#include "localizer/localizer_params.hpp"
+
+namespace lidarloop {
+
+// What is wrong, as bits: an estimate with none set is "ok".
+enum HealthFlag : uint32_t {
+  kNotInitialized = 1u << 0,   // no GPS fix yet: there is no pose to report
+  kCanGap = 1u << 1,           // no CAN for can_timeout: prediction holds the last speed and steering
+  kNoGps = 1u << 2,            // no fix for gps_timeout
+  kInvalidPoints = 1u << 3,    // the scan had NaN or infinite points (dropped)
+  kEmptyScan = 1u << 4,        // too few valid points to match
+  kNoCorridor = 1u << 5,       // no corridor around the pose (off the map?): all points used
+  kNoGroundPlane = 1u << 6,    // no plane fit: no obstacle removal this scan
+  kFewCurbs = 1u << 7,         // too few curb features: no curb observation (occluded curbs, open area)
+  kCurbMatchRejected = 1u << 8,  // the curb match disagreed with the filter or explained too few curbs
+  kNoIntensityMatch = 1u << 9,   // APS had too few usable cells (off the intensity map, road hidden)
+  kIntensityMatchRejected = 1u << 10,
+};
+constexpr int kHealthFlagCount = 11;
+// "ok", or the set flags as words: "no GPS, few curbs".
+std::string describe_health(uint32_t flags);
+
+// Wall time spent per stage of one scan, ms (zero for stages the method skips).
+enum class Stage { deskew, corridor, obstacles, curb_detection, curb_features, curb_matching, intensity_matching, fusion };
+constexpr int kStageCount = 8;
+const char* stage_name(Stage s);
+
+struct LocalizerEstimate {
+  int64_t stamp_ns = 0;  // the pose's time: the scan's last firing
+  Pose2d pose;           // rear axle, local frame of the map
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // x, y, psi
+  uint32_t health = kNotInitialized;
+
+  // Diagnostics of this scan.
+  size_t points = 0, dropped_points = 0, corridor_points = 0, obstacle_points = 0;
+  size_t curbs_detected = 0, curb_features = 0;
+  std::optional<Pose2d> curb_observation;
+  double curb_inlier_ratio = 0;
+  std::optional<Eigen::Vector2d> intensity_observation;
+  int intensity_cells = 0;
+  std::array<double, kStageCount> stage_ms{};
+  double total_ms = 0;
+
+  bool ok() const { return health == 0; }
+};
+
+// The features of the last scan, for pictures (the paper's Fig. 14); vehicle frame.
+struct ScanFeatures {
+  std::vector<Eigen::Vector2d> curbs, obstacles;
+};
+
+class Localizer {
+ public:
+  // `map` must outlive the localizer (its intensity layer loads tiles as the car moves).
+  Localizer(HdMap& map, const LocalizerParams& params);
+
+  void on_can(const CanFrame& frame);
+  void on_gps(const GpsFix& fix);
+  LocalizerEstimate on_scan(const PointCloud& cloud);
+
+  // A known start instead of waiting for the first GPS fix.
+  void initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance);
+  bool initialized() const { return filter_.has_value(); }
+  // The filter's current pose (predicted to the latest message); nullopt before initialisation.
+  std::optional<Pose2d> pose() const;
+
+  const LocalizerParams& params() const { return params_; }
+  const ScanFeatures& last_features() const { return features_; }
+
+ private:
+  void predict_to(int64_t t_ns);
+  uint32_t input_health(int64_t t_ns) const;
+  void match_curbs(const std::vector<Eigen::Vector2d>& features, LocalizerEstimate& e);
+  void match_intensity(const std::vector<Eigen::Vector3d>& ground, const std::vector<double>& intensities,
+                       LocalizerEstimate& e);
+  // The chi^2 gate with its escape after max_rejections in a row; true: use the observation.
+  bool gate(double mahalanobis_sq, double threshold, int& rejections) const;
+
+  HdMap& map_;
+  LocalizerParams params_;
+  LocalFrame frame_;
+  MapIndex map_index_;
+  std::mt19937_64 rng_;
+
+  MotionPredictor predictor_;
+  Pose2d odometry_;  // dead reckoning from CAN alone: what the curb accumulation moves frames by
+  std::optional<PoseFilter> filter_;
+  int64_t time_ns_ = 0;  // the time odometry and filter are predicted to
+  double speed_ = 0, steer_ = 0;  // the last CAN frame's (held until the next)
+  std::optional<int64_t> last_can_ns_, last_gps_ns_;
+
+  CurbAccumulator accumulator_;
+  std::optional<Pose2d> previous_scan_odometry_;
+  int curb_rejections_ = 0, intensity_rejections_ = 0;
+  ScanFeatures features_;
+};
+
+}  // namespace lidarloop

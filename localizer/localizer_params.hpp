@@ -1,0 +1,96 @@
+#pragma once
+// Every parameter of the localizer in one place, with the paper's defaults (Table I) where it gives
+// them, and the YAML section that overrides them (a scenario's `localizer:`). The keys are the field
+// names, grouped by module; see the README's localizer section for the list.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "common/yaml_reader.hpp"
+#include "localizer/aps_matcher.hpp"
+#include "localizer/curb_detector.hpp"
+#include "localizer/curb_features.hpp"
+#include "localizer/curb_match_covariance.hpp"
+#include "localizer/driving_corridor.hpp"
+#include "localizer/obstacle_rejection.hpp"
+#include "localizer/pose_filter.hpp"
+#include "localizer/probabilistic_icp.hpp"
+
+namespace lidarloop {
+
+// The paper's method and the baselines of its Tables II and III. Every method runs in the same
+// filter (prediction from CAN, KF1 with GPS); they differ in the map-matching observations of KF2:
+//   gps        none
+//   icp        plain ICP on the curb features, no obstacle removal (corridor, plane, d_o all off)
+//   icp-obs    plain ICP on curb features after obstacle removal
+//   m-icp      biweight M-ICP (Eq. 21-22) after obstacle removal
+//   fmt        Fourier-Mellin on curb grid images after obstacle removal
+//   intensity  APS on the intensity layer only
+//   proposed   probabilistic ICP after obstacle removal, and APS
+enum class LocalizerMethod { gps, icp, icp_obs, m_icp, fmt, intensity, proposed };
+
+const std::vector<std::string>& localizer_method_names();
+std::string method_name(LocalizerMethod m);
+// Throws std::invalid_argument listing the valid names.
+LocalizerMethod parse_localizer_method(const std::string& name);
+
+bool uses_curbs(LocalizerMethod m);
+bool uses_intensity(LocalizerMethod m);
+bool removes_obstacles(LocalizerMethod m);
+
+// When the localizer calls its inputs unhealthy, and what it refuses to use.
+struct HealthParams {
+  double gps_timeout_s = 1.0;  // no fix for this long: "no GPS"
+  double can_timeout_s = 0.1;  // no CAN frame for this long: "CAN gap" (the bus runs at 100 Hz)
+  int min_scan_points = 1000;  // fewer valid points: treated as an empty scan
+  int min_curbs = 15;          // fewer curb features (n_p): no curb observation
+  double min_inlier_ratio = 0.5;  // a match explaining fewer of the features is not used
+  // Innovation gate of the map-matching observations: chi^2 with 3 (curbs) or 2 (intensity) degrees of
+  // freedom at 99.9 %. Past `max_rejections` in a row the observation is taken anyway: the filter, not
+  // the map, is then the likelier to be wrong, and refusing forever would never let it recover.
+  double gate_curb = 16.27, gate_intensity = 13.82;
+  int max_rejections = 10;
+};
+
+struct GpsNoise {
+  double min_sigma_m = 0.5;          // floor on the receiver's reported position sigma
+  double min_heading_sigma_rad = 0.02;
+  // Scales the receiver's variances. A low-cost receiver's error is mostly a slowly wandering bias,
+  // so fixes 0.1 s apart are far from independent; 1 keeps the paper's plain KF1.
+  double variance_scale = 1.0;
+};
+
+struct LocalizerParams {
+  LocalizerMethod method = LocalizerMethod::proposed;
+  bool deskew = true;  // beyond the paper: per-point motion compensation from CAN
+  // The LiDAR's pose in the vehicle frame (the extrinsic calibration). Not in YAML: it comes with the
+  // sensor data (scenario's lidar section, a log's transforms).
+  Eigen::Isometry3d lidar_mount = Eigen::Isometry3d::Identity();
+  uint64_t seed = 1;               // probabilistic ICP's draws
+  double map_window_m = 32;        // curbs of the map within this half size are matched against
+  double max_prediction_step_s = 0.01;  // Eq. 19 is integrated in steps no longer than this
+
+  CorridorParams corridor;
+  ObstacleParams obstacles;
+  CurbDetectorParams curb_detector;
+  CurbFeatureParams curb_features;
+  ProbabilisticIcpParams probabilistic_icp;
+  IcpParams icp;   // the icp and icp-obs baselines
+  MIcpParams m_icp;
+  IntensityGridParams intensity_grid;
+  ApsParams aps;
+  VehicleModelParams vehicle;
+  PoseFilterParams filter;
+  double process_position_without_can_per_s = 2.0;  // m per s of dead reckoning without CAN
+  CurbMatchNoise curb_noise;
+  GpsNoise gps_noise;
+  HealthParams health;
+};
+
+// Overrides `params` from a `localizer:` mapping (the key `method` included). Unknown keys, wrong
+// types and out-of-range values are InputErrors naming the file, line and column.
+void read_localizer_params(const YamlReader& y, const YAML::Node& node, LocalizerParams& params);
+
+}  // namespace lidarloop

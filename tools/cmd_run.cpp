@@ -1,0 +1,227 @@
+// lidarloop run / compare: a scenario with the localizer in the loop, scored against ground truth.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <unistd.h>
+
+#include "common/input_error.hpp"
+#include "tools/birdseye.hpp"
+#include "tools/commands.hpp"
+#include "tools/error_plots.hpp"
+#include "tools/localizer_loop.hpp"
+#include "tools/localizer_setup.hpp"
+#include "tools/result_files.hpp"
+#include "tools/scene_setup.hpp"
+
+namespace lidarloop {
+namespace {
+
+std::vector<TruthPose> truth_poses(const LoopResult& r) {
+  std::vector<TruthPose> out;
+  out.reserve(r.truth.size());
+  for (const auto& t : r.truth) out.push_back({t.stamp_ns, t.pose});
+  return out;
+}
+
+std::vector<EstimateRecord> estimate_records(const MethodTrace& trace) {
+  std::vector<EstimateRecord> out;
+  out.reserve(trace.estimates.size());
+  for (const auto& e : trace.estimates)
+    if (!(e.health & kNotInitialized)) out.push_back({e.stamp_ns, e.pose, e.covariance, describe_health(e.health), e.total_ms});
+  return out;
+}
+
+// The true pose's distance from the lane centre the ego was told to follow (closed loop: how far a
+// localizer's error pushed the car).
+double max_lane_offset(const LoopResult& r, const Path& route) {
+  double worst = 0, s = 0;
+  constexpr double kSearch = 30.0;  // m along the route around the previous projection
+  for (size_t i = 0; i < r.truth.size(); ++i) {
+    const Eigen::Vector2d p(r.truth[i].pose.x, r.truth[i].pose.y);
+    s = i == 0 ? route.project(p) : route.project(p, std::max(0.0, s - kSearch), std::min(route.length, s + kSearch));
+    const Pose2d on = route.pose_at(s);
+    worst = std::max(worst, std::abs(-std::sin(on.yaw) * (p.x() - on.x) + std::cos(on.yaw) * (p.y() - on.y)));
+  }
+  return worst;
+}
+
+struct Progress {
+  bool terminal = isatty(STDOUT_FILENO) != 0;
+  std::string what;
+  double duration_s = 0;
+  void operator()(double fraction) const {
+    if (!terminal) return;
+    std::printf("\r%s %3d%%  %.1f of %.1f s", what.c_str(), int(fraction * 100), fraction * duration_s, duration_s);
+    std::fflush(stdout);
+  }
+  void clear() const {
+    if (terminal) std::printf("\r%70s\r", "");
+  }
+};
+
+void write_worst_frame(const std::string& path, const WorstFrame& w, const HdMap& map, const std::string& method) {
+  if (w.error_m < 0) return;
+  auto place = [&](const std::vector<Eigen::Vector2d>& vehicle_points) {
+    std::vector<Eigen::Vector2d> world;
+    const double c = std::cos(w.estimate.yaw), s = std::sin(w.estimate.yaw);
+    for (const auto& p : vehicle_points)
+      world.emplace_back(w.estimate.x + c * p.x() - s * p.y(), w.estimate.y + s * p.x() + c * p.y());
+    return world;
+  };
+  BirdseyeOptions o;
+  std::ostringstream title;
+  title.precision(2);
+  title << std::fixed << method << ": worst frame, position error " << w.error_m << " m";
+  o.title = title.str();
+  o.marks = {{"curb features (placed at the estimate)", place(w.features.curbs), {0, 0, 255}},
+             {"obstacle points (placed at the estimate)", place(w.features.obstacles), {255, 0, 255}}};
+  o.poses = {{"ground truth", w.truth, {255, 255, 255}}, {"estimate", w.estimate, {0, 200, 255}}};
+  write_birdseye_png(path, w.cloud, w.sensor_pose, map.curbs.map().curbs, o);
+}
+
+void print_metrics_table(const std::vector<Metrics>& metrics) { std::cout << comparison_markdown(metrics); }
+
+int run_run(const Args& args) {
+  const int threads = thread_count(args);
+  const auto limit = limit_threads(threads);
+  LoadedScenario s = load_scenario_and_world(args.positional().at(0));
+  if (args.value("seed")) s.scenario.seed = uint64_t(args.integer("seed", 0, 0, 1L << 62));
+  if (args.value("duration")) s.scenario.duration_s = args.number("duration", s.scenario.duration_s);
+  if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");
+  if (auto loop = args.value("loop")) {
+    if (*loop != "open" && *loop != "closed") throw InputError("--loop must be open or closed, got '" + *loop + "'");
+    s.scenario.closed_loop = *loop == "closed";
+  }
+  const LocalizerParams params = localizer_params_for(s.scenario, args.value("method"));
+  const std::string name = std::filesystem::path(s.scenario.file).stem().string();
+  const std::string out = args.text("out", "out/" + name);
+  std::filesystem::create_directories(out);
+
+  HdMap map = open_scenario_map(s.scenario);
+  Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
+  const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_name(params.method), s.scenario.duration_s};
+  const LoopResult r = run_localizer_loop(sim, map, {params}, s.scenario.closed_loop, nullptr, std::ref(progress));
+  progress.clear();
+
+  const MethodTrace& trace = r.methods.front();
+  const std::vector<EstimateRecord> estimates = estimate_records(trace);
+  const std::vector<TruthPose> truth = truth_poses(r);
+  const ScoredRun scored = score(truth, estimates, s.scenario.pass, trace.method, name);
+  write_metrics_json(out + "/metrics.json", scored.metrics);
+  write_errors_csv(out + "/errors.csv", scored, estimates);
+  write_tum(out + "/estimate.tum", estimates);
+  write_tum(out + "/truth.tum", truth);
+  write_junit(out + "/junit.xml", {scored.metrics});
+  write_error_plot(out + "/errors.png", scored.errors);
+  write_trajectory_plot(out + "/trajectory.png", truth, estimates, scored.errors, map.curbs.map().curbs);
+  write_worst_frame(out + "/worst_frame.png", trace.worst, map, trace.method);
+
+  print_metrics_table({scored.metrics});
+  std::printf("\nscenario   %s (seed %llu, %s loop), %.1f s simulated in %.1f s wall (%.1fx real time, %d thread(s))\n",
+              s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.closed_loop ? "closed" : "open",
+              s.scenario.duration_s, r.wall_s, s.scenario.duration_s / r.wall_s, threads);
+  std::printf("localizer  %zu scans, %.2f ms per scan on average, %.1f%% of the loop's time\n", r.scans,
+              1e3 * r.localizer_wall_s / double(std::max<size_t>(r.scans, 1)), 100 * r.localizer_wall_s / r.wall_s);
+  std::printf("lane       the car stayed within %.2f m of its lane's centre\n",
+              max_lane_offset(r, sim.resolved().ego_route));
+  for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
+  std::printf("result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
+              "trajectory.png, worst_frame.png)\n",
+              scored.metrics.pass ? "PASS" : "FAIL", out.c_str());
+  return scored.metrics.pass ? 0 : 1;
+}
+
+std::vector<std::string> parse_methods(const std::string& list) {
+  if (list == "all") return localizer_method_names();
+  std::vector<std::string> out;
+  std::stringstream ss(list);
+  for (std::string m; std::getline(ss, m, ',');) {
+    if (m.empty()) throw InputError("--methods: empty method name in '" + list + "'");
+    out.push_back(m);
+  }
+  return out;
+}
+
+int run_compare(const Args& args) {
+  const int threads = thread_count(args);
+  const auto limit = limit_threads(threads);
+  LoadedScenario s = load_scenario_and_world(args.positional().at(0));
+  if (args.value("seed")) s.scenario.seed = uint64_t(args.integer("seed", 0, 0, 1L << 62));
+  if (args.value("duration")) s.scenario.duration_s = args.number("duration", s.scenario.duration_s);
+  if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");
+  std::vector<LocalizerParams> params;
+  for (const auto& m : parse_methods(args.text("methods", "all"))) params.push_back(localizer_params_for(s.scenario, m));
+  const std::string name = std::filesystem::path(s.scenario.file).stem().string();
+  const std::string out = args.text("out", "out/" + name + "-compare");
+  std::filesystem::create_directories(out);
+
+  HdMap map = open_scenario_map(s.scenario);
+  // Open loop: every method sees the same drive; in closed loop each would drive its own.
+  Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
+  const Progress progress{isatty(STDOUT_FILENO) != 0, "compare", s.scenario.duration_s};
+  const LoopResult r = run_localizer_loop(sim, map, params, false, nullptr, std::ref(progress));
+  progress.clear();
+
+  const std::vector<TruthPose> truth = truth_poses(r);
+  std::vector<Metrics> metrics;
+  for (const auto& trace : r.methods) {
+    const std::vector<EstimateRecord> estimates = estimate_records(trace);
+    const ScoredRun scored = score(truth, estimates, s.scenario.pass, trace.method, name);
+    const std::string dir = out + "/" + trace.method;
+    std::filesystem::create_directories(dir);
+    write_metrics_json(dir + "/metrics.json", scored.metrics);
+    write_errors_csv(dir + "/errors.csv", scored, estimates);
+    write_tum(dir + "/estimate.tum", estimates);
+    write_error_plot(dir + "/errors.png", scored.errors);
+    write_worst_frame(dir + "/worst_frame.png", trace.worst, map, trace.method);
+    metrics.push_back(scored.metrics);
+  }
+  write_tum(out + "/truth.tum", truth);
+  write_junit(out + "/junit.xml", metrics);
+  write_comparison_csv(out + "/comparison.csv", metrics);
+  const std::string table = comparison_markdown(metrics);
+  if (FILE* f = std::fopen((out + "/comparison.md").c_str(), "w")) {
+    std::fputs(table.c_str(), f);
+    std::fclose(f);
+  } else {
+    throw InputError(out + "/comparison.md: cannot write file");
+  }
+  std::cout << table;
+  std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n", s.scenario.file.c_str(),
+              (unsigned long long)s.scenario.seed, s.scenario.duration_s, r.scans, metrics.size());
+  std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, truth.tum, <method>/...)\n", out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command run_command() {
+  return {{"run", "lidarloop run SCENARIO.yaml [--method NAME] [--loop open|closed] [--out DIR] [--seed N]",
+           "Run a scenario with the localizer in the loop and score it against ground truth. Writes\n"
+           "metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and plots to DIR. Exit 0 when\n"
+           "every threshold of the scenario's `pass` holds, 1 when one fails, 2 on bad input.",
+           {{"method", "NAME", "gps, icp, icp-obs, m-icp, fmt, intensity or proposed (default: the scenario's)"},
+            {"loop", "open|closed", "closed: the controller steers on the estimate (default: the scenario's)"},
+            {"out", "DIR", "output folder (default out/<scenario name>)"},
+            {"seed", "N", "override the scenario's seed"},
+            {"duration", "S", "override the scenario's duration, seconds"},
+            {"threads", "N", "worker threads (default: all cores)"}},
+           1, 1},
+          run_run};
+}
+
+Command compare_command() {
+  return {{"compare", "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--out DIR] [--seed N]",
+           "Simulate a scenario once and feed the identical streams to several localizer methods; print\n"
+           "and write a table like the paper's Table III (comparison.md, comparison.csv).",
+           {{"methods", "LIST", "all, or a comma-separated list of methods (default all)"},
+            {"out", "DIR", "output folder (default out/<scenario name>-compare)"},
+            {"seed", "N", "override the scenario's seed"},
+            {"duration", "S", "override the scenario's duration, seconds"},
+            {"threads", "N", "worker threads (default: all cores)"}},
+           1, 1},
+          run_compare};
+}
+
+}  // namespace lidarloop

@@ -1,0 +1,48 @@
+#pragma once
+// The simulator and the localizer in one loop: every CAN frame, GPS fix and scan the simulation emits
+// goes, in time order, to one or more localizers (one per method: `compare` feeds them all the same
+// stream), and each scan's estimate is kept with the ground truth for scoring. In closed loop the
+// first method's estimate is what the controller steers on.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "localizer/localizer.hpp"
+#include "sim/simulation.hpp"
+
+namespace lidarloop {
+
+// The frame with the largest position error of a method, kept for the bird's-eye picture (Fig. 14).
+struct WorstFrame {
+  double error_m = -1;
+  PointCloud cloud;
+  Eigen::Isometry3d sensor_pose = Eigen::Isometry3d::Identity();  // true LiDAR pose at the scan's stamp
+  ScanFeatures features;
+  Pose2d truth, estimate;
+};
+
+struct MethodTrace {
+  std::string method;
+  std::vector<LocalizerEstimate> estimates;
+  WorstFrame worst;
+};
+
+struct LoopResult {
+  std::vector<TruthSample> truth;
+  std::vector<MethodTrace> methods;
+  std::vector<std::vector<ActorSample>> actors;  // per scan
+  double wall_s = 0;            // whole loop
+  double localizer_wall_s = 0;  // inside the localizers
+  double max_cross_track_m = 0; // how far the controller strayed from its lane's centre
+  size_t scans = 0;
+};
+
+// Runs `sim` to its end. `also`: another sink that sees every stream too (a recorder), or null.
+// `progress` is called with the fraction done. Closed loop: the controller steers on the first
+// method's pose (its filter, predicted to the latest CAN frame) once that is initialised.
+LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<LocalizerParams>& methods,
+                              bool closed_loop, StreamSink* also = nullptr,
+                              const std::function<void(double)>& progress = {});
+
+}  // namespace lidarloop
