@@ -111,7 +111,9 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
 
   // The map under the vehicle-frame window: mean, floored standard deviation, and a summed-area table
   // of the cells without data (to ask in O(1) whether an S cell stays on the map at every offset).
-  std::vector<double> map_mean(size_t(ww) * size_t(wh), 0.0), map_sigma(size_t(ww) * size_t(wh), params.min_sigma);
+  // Single precision for the search: intensities are whole counts 0-255 and the sums a few thousand
+  // z-scores, far inside float's 7 digits, and the inner loop does twice the offsets per instruction.
+  std::vector<float> map_mean(size_t(ww) * size_t(wh), 0.0f), map_sigma(size_t(ww) * size_t(wh), float(params.min_sigma));
   std::vector<int> missing_sat(size_t(ww + 1) * size_t(wh + 1), 0);
   for (int r = 0; r < wh; ++r) {
     int row_missing = 0;
@@ -120,11 +122,11 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
       const std::optional<IntensityCell> m = map.cell(local);
       const size_t k = size_t(r) * size_t(ww) + size_t(c);
       if (m && m->count > 0) {
-        map_mean[k] = m->mean;
+        map_mean[k] = float(m->mean);
         // Eq. 14 as printed adds variances and squares the sum, which is dimensionally intensity^4
         // over intensity^2; reading sigma as the standard deviation makes the exponent a squared
         // z-score, as in APS.
-        map_sigma[k] = std::max(std::sqrt(m->variance()), params.min_sigma);
+        map_sigma[k] = float(std::max(std::sqrt(m->variance()), params.min_sigma));
       } else {
         ++row_missing;
       }
@@ -141,7 +143,7 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
   // Eq. 14 in logs: log P(o) = alpha * sum -(m_r - s_r)^2 / (2 (m_sigma + s_sigma)^2). The loop over
   // offsets is innermost: each offset has its own accumulator, so it vectorises.
   const int ox = 2 * nx + 1, oy = 2 * ny + 1;
-  std::vector<double> sum_sq(size_t(ox) * size_t(oy), 0.0);  // sum of squared z-scores per offset
+  std::vector<float> sum_sq(size_t(ox) * size_t(oy), 0.0f);  // sum of squared z-scores per offset
   int used = 0;
   for (int r = 0; r < h; ++r) {
     for (int c = 0; c < w; ++c) {
@@ -150,13 +152,13 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
       // Window cell (c, r) is S cell (c, r) shifted by the most negative offset.
       if (missing_in(c, r, 2 * margin_x + 1, 2 * margin_y + 1) != 0) continue;
       ++used;
-      const double s_r = s.mean, s_sigma = std::max(std::sqrt(s.variance()), params.min_sigma);
+      const float s_r = float(s.mean), s_sigma = float(std::max(std::sqrt(s.variance()), params.min_sigma));
       for (int j = 0; j < oy; ++j) {
         const size_t base = size_t(r + j * step_cells) * size_t(ww) + size_t(c);
-        double* acc = &sum_sq[size_t(j) * size_t(ox)];
+        float* acc = &sum_sq[size_t(j) * size_t(ox)];
         for (int i = 0; i < ox; ++i) {
           const size_t k = base + size_t(i * step_cells);
-          const double d = map_mean[k] - s_r, e = map_sigma[k] + s_sigma;
+          const float d = map_mean[k] - s_r, e = map_sigma[k] + s_sigma;
           acc[i] += d * d / (e * e);
         }
       }
@@ -176,7 +178,7 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
 
   // Normalise by the best offset before exponentiating: the raw sums are thousands, exp() would be 0.
   std::vector<double> log_p(sum_sq.size());
-  for (size_t k = 0; k < sum_sq.size(); ++k) log_p[k] = -0.5 * params.alpha * sum_sq[k];
+  for (size_t k = 0; k < sum_sq.size(); ++k) log_p[k] = -0.5 * params.alpha * double(sum_sq[k]);
   const double best = *std::max_element(log_p.begin(), log_p.end());
   double total = 0;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();

@@ -489,13 +489,24 @@ std::optional<IntensityCell> IntensityMap::cell(const Eigen::Vector2d& xy) {
 // The returned pointer is valid until the next call (which may evict it).
 const std::vector<IntensityCell>* IntensityMap::tile(int tx, int ty) {
   const std::pair<int, int> key{tx, ty};
+  if (key == last_key_) return last_tile_;  // still cached: only a lookup of another tile evicts
+  last_key_ = key;
+  last_tile_ = lookup_tile(key);
+  return last_tile_;
+}
+
+const std::vector<IntensityCell>* IntensityMap::lookup_tile(const std::pair<int, int>& key) {
+  const auto [tx, ty] = key;
   if (present_.find(key) == present_.end()) return nullptr;  // not in the map: no data there
   if (auto hit = cache_.find(key); hit != cache_.end()) {
     lru_.splice(lru_.begin(), lru_, hit->second.second);
     return &hit->second.first;
   }
   // Loaded before touching the cache, so a bad tile leaves the cache as it was.
+  // On a bad tile last_key_ must not keep pointing at it.
+  last_key_ = {INT32_MIN, INT32_MIN};
   std::vector<IntensityCell> cells = load_tile(fs::path(dir_) / kTilesDir / tile_file_name(tx, ty), header_, tx, ty);
+  last_key_ = key;
   ++loads_;
   if (cache_.size() >= max_cached_) {
     cache_.erase(lru_.back());

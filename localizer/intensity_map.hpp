@@ -100,6 +100,7 @@ class IntensityMap {
 
  private:
   const std::vector<IntensityCell>* tile(int tx, int ty);
+  const std::vector<IntensityCell>* lookup_tile(const std::pair<int, int>& key);
 
   std::string dir_;
   IntensityMapHeader header_;
@@ -108,6 +109,10 @@ class IntensityMap {
   std::map<std::pair<int, int>, std::pair<std::vector<IntensityCell>, std::list<std::pair<int, int>>::iterator>> cache_;
   std::map<std::pair<int, int>, bool> present_;
   size_t loads_ = 0;
+  // The tile of the previous lookup: neighbouring queries nearly always hit it, and skipping the
+  // cache's tree and LRU bookkeeping for them is most of a map lookup's cost (APS asks ~50 k a scan).
+  std::pair<int, int> last_key_{INT32_MIN, INT32_MIN};
+  const std::vector<IntensityCell>* last_tile_ = nullptr;
 };
 
 IntensityMapHeader read_intensity_map_header(const std::string& dir);

@@ -187,9 +187,9 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .done();
   top.section("filter");
   Section(y, node["filter"], "filter")
-      .number("process_position_per_m", p.filter.process_position_per_m, 0.0, 10.0)
-      .number("process_yaw_per_m", p.filter.process_yaw_per_m, 0.0, 1.0)
-      .number("process_position_per_s", p.filter.process_position_per_s, 0.0, 10.0)
+      .number("position_per_sqrt_m", p.filter.position_per_sqrt_m, 0.0, 10.0)
+      .number("yaw_per_sqrt_m", p.filter.yaw_per_sqrt_m, 0.0, 1.0)
+      .number("position_per_sqrt_s", p.filter.position_per_sqrt_s, 0.0, 10.0)
       .done();
   top.section("curb_noise");
   Section(y, node["curb_noise"], "curb_noise")

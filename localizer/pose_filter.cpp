@@ -44,9 +44,10 @@ void PoseFilter::predict(const Pose2d& predicted, double distance, double dt) {
   F(0, 2) = -dpy;
   F(1, 2) = dpx;
   x_ = Eigen::Vector3d(predicted.x, predicted.y, predicted.yaw);
-  const double q_pos = params_.process_position_per_m * distance + params_.process_position_per_s * std::sqrt(dt);
-  const double q_yaw = params_.process_yaw_per_m * distance;
-  Eigen::Matrix3d Q = Eigen::Vector3d(q_pos * q_pos, q_pos * q_pos, q_yaw * q_yaw + 1e-12).asDiagonal();
+  auto sq = [](double v) { return v * v; };
+  const double q_pos = sq(params_.position_per_sqrt_m) * distance + sq(params_.position_per_sqrt_s) * dt;
+  const double q_yaw = sq(params_.yaw_per_sqrt_m) * distance;
+  const Eigen::Matrix3d Q = Eigen::Vector3d(q_pos, q_pos, q_yaw).asDiagonal();
   P_ = F * P_ * F.transpose() + Q;
 }
 

@@ -36,11 +36,14 @@ class MotionPredictor {
   double beta_ = 0, yaw_rate_ = 0;  // Eq. 19's dynamic states
 };
 
+// Process noise as random walks, so that it does not depend on how often predict() is called (CAN at
+// 100 Hz or a gap of a second): variances grow linearly with the distance driven and the time passed.
 struct PoseFilterParams {
-  double process_position_per_m = 0.2;   // m per m driven: wheel slip, scale error and model error, set so
-                                          // the filter follows GPS rather than lagging its slow bias
-  double process_yaw_per_m = 0.002;       // rad per m driven
-  double process_position_per_s = 0.2;   // m per sqrt(s): what odometry cannot see (keeps GPS gain up)
+  double position_per_sqrt_m = 0.05;  // m / sqrt(m): wheel slip, speed scale error, model error
+  double yaw_per_sqrt_m = 0.002;      // rad / sqrt(m): steering offset, Eq. 19's simplifications
+  // m / sqrt(s): what odometry cannot see; also what lets the low-cost GPS's slowly wandering bias through,
+  // so that with GPS alone the estimate follows the GPS within seconds rather than lagging it.
+  double position_per_sqrt_s = 0.2;
 };
 
 class PoseFilter {

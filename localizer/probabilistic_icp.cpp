@@ -1,5 +1,7 @@
 #include "localizer/probabilistic_icp.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -247,19 +249,19 @@ IcpResult probabilistic_icp(const MapIndex& map, const std::vector<Eigen::Vector
     sample.assign(order.begin(), order.begin() + std::ptrdiff_t(n_p));
   }
 
-  // Each iteration writes only its own slot. Sequential: TBB is not linked into the localizer, and
-  // n_t = 30 ICPs over a few hundred curbs take about a millisecond each.
+  // The draws are independent and each writes only its own slot, so they run in parallel and the
+  // fused result does not depend on the thread count or the schedule.
   std::vector<IcpHypothesis> hypotheses(samples.size());
-  std::vector<Eigen::Vector2d> subset;
-  for (size_t i = 0; i < samples.size(); ++i) {
-    subset.clear();
+  tbb::parallel_for(size_t{0}, samples.size(), [&](size_t i) {
+    std::vector<Eigen::Vector2d> subset;
+    subset.reserve(samples[i].size());
     for (size_t k : samples[i]) subset.push_back(curbs[k]);
     // Local ICP: a rough T_l,i from the subset (no rejection: with n_p points, every one counts).
     const IcpResult local = icp(map, subset, initial, params.local);
     // Global ICP from T_l,i on all curbs with Eq. 12 rejection at d_g -> T_g,i and its outlier ratio.
     const IcpResult global = icp(map, curbs, local.t, params.global, params.d_g);
     hypotheses[i] = {global.t, global.outlier_ratio};
-  }
+  });
 
   result.t = fuse_hypotheses(hypotheses, params.outlier_softness_curbs / double(n));  // Eq. 13
   result.iterations = n_t;

@@ -55,9 +55,14 @@ TEST(Deskew, CompensatedScansSeeTheWallWhereItIs) {
 TEST(Deskew, NonFinitePointsAreDropped) {
   PointCloud cloud;
   cloud.points = {{1, 2, 3, 10, 0, 0}, {NAN, 0, 0, 10, 0, 1152}, {4, 5, 6, 10, 1, 1152}};
-  EXPECT_EQ(deskew(cloud, Eigen::Isometry3d::Identity(), {5, 0}, 0).size(), 2u);
+  const ScanPoints kept = deskew(cloud, Eigen::Isometry3d::Identity(), {5, 0}, 0);
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_EQ(kept.dropped, 1u);
+  // Ring and intensity stay with their point.
+  EXPECT_EQ(kept.ring[1], 1);
+  EXPECT_EQ(kept.intensity[1], 10);
   EXPECT_EQ(to_vehicle_frame(cloud, Eigen::Isometry3d::Identity()).size(), 2u);
-  EXPECT_TRUE(deskew(PointCloud{}, Eigen::Isometry3d::Identity(), {5, 0}, 0).empty());
+  EXPECT_EQ(deskew(PointCloud{}, Eigen::Isometry3d::Identity(), {5, 0}, 0).size(), 0u);
 }
 
 }  // namespace

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <limits>
 #include <numbers>
 
@@ -142,12 +141,6 @@ void draw_panel(cv::Mat& image, const Panel& p, const std::vector<double>& t, co
   text(image, title, {p.area.x, p.area.y - 10}, kTitleFontScale);
 }
 
-double rms(const std::vector<double>& v) {
-  double sum = 0;
-  for (double x : v) sum += x * x;
-  return v.empty() ? 0 : std::sqrt(sum / double(v.size()));
-}
-
 // A colour for 0..1 from OpenCV's Turbo map (blue = small, red = large).
 cv::Scalar turbo(double fraction) {
   static const cv::Mat colours = [] {
@@ -195,7 +188,7 @@ void write_error_plot(const std::string& path, const std::vector<FrameError>& er
     p.t0 = t0, p.t1 = t1, p.v0 = lo - pad, p.v1 = hi + pad;
     const std::string title = std::string(panels[k].name) + " (" + panels[k].unit + ")" +
                               (v.empty() ? std::string(": no scored frames")
-                                         : ", RMSE " + fixed(rms(v), 3) + " " + panels[k].unit);
+                                         : ", RMSE " + fixed(rmse(v), 3) + " " + panels[k].unit);
     draw_panel(image, p, t, v, title);
   }
   text(image, "time (s)", {kLeftMargin + (size.width - kLeftMargin - kRightMargin) / 2, size.height - 12},

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include "localizer/probabilistic_icp.hpp"  // wrap_angle

@@ -1,0 +1,190 @@
+// The FMT baseline (the paper's `fmt`, ref. [36]): recovery of a known pose error on a synthetic
+// T-junction, pure translation to a cell, each sign convention on its own, a rotation near 180 degrees
+// (the magnitude spectrum's ambiguity), and refusal of empty, non-finite and unrelated input.
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+
+#include "localizer/fmt_matcher.hpp"
+
+namespace lidarloop {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kSpacing = 0.1;  // m between map curb points (the map's resolution)
+
+// The junction sits far from the local origin, so a rotation about the wrong point shows.
+const Eigen::Vector2d kOrigin(150.0, -80.0);
+constexpr double kHalfRoad = 3.5;                     // two curbs 7 m apart along x
+constexpr double kRoadMin = -40, kRoadMax = 40;       // m along x, past the grid's +-25 m
+constexpr double kSideLeft = 1.0, kSideRight = 8.0;   // a side road going north, 7 m wide
+constexpr double kSideEnd = 30.0;                     // m north of the main road's axis
+
+// The vehicle's true position (relative to kOrigin): on the main road, short of the junction.
+const Eigen::Vector2d kVehicle(-2.0, -1.0);
+constexpr double kScanRange = 20.0;  // m: curbs detected around the vehicle (beam model +-25 m)
+constexpr double kCurbNoise = 0.03;  // m, detected curbs about the mapped line
+constexpr int kScanStride = 2;       // detected curbs are sparser than the map's points
+
+// Tolerances of the brief: one or two cells, half a degree.
+constexpr double kPositionTolerance = 0.1;
+constexpr double kHeadingTolerance = 0.5 * kDeg;
+
+void add_line(std::vector<Eigen::Vector2d>& out, Eigen::Vector2d a, Eigen::Vector2d b) {
+  const int n = static_cast<int>(std::round((b - a).norm() / kSpacing));
+  for (int i = 0; i <= n; ++i) out.push_back(kOrigin + a + (b - a) * (double(i) / n));
+}
+
+std::vector<Eigen::Vector2d> junction_map() {
+  std::vector<Eigen::Vector2d> map;
+  add_line(map, {kRoadMin, -kHalfRoad}, {kRoadMax, -kHalfRoad});       // south curb, unbroken
+  add_line(map, {kRoadMin, kHalfRoad}, {kSideLeft, kHalfRoad});        // north curb, west of the side road
+  add_line(map, {kSideRight, kHalfRoad}, {kRoadMax, kHalfRoad});       // north curb, east of it
+  add_line(map, {kSideLeft, kHalfRoad}, {kSideLeft, kSideEnd});        // the side road's curbs
+  add_line(map, {kSideRight, kHalfRoad}, {kSideRight, kSideEnd});
+  return map;
+}
+
+struct Case {
+  std::vector<Eigen::Vector2d> curbs_world;  // detected curbs placed in the world at the prior pose
+  Eigen::Vector2d prior;                     // the prior position: the grid centre
+  Eigen::Vector2d truth;                     // where the correction must take the prior
+};
+
+// Detected curbs: every kScanStride-th map point within kScanRange of the vehicle, with noise, placed
+// in the world with a prior pose that is off by `error`: the correction that undoes it is `error`.
+Case make_case(const std::vector<Eigen::Vector2d>& map, const Transform2d& error) {
+  std::mt19937_64 rng(42);
+  std::normal_distribution<double> noise(0.0, kCurbNoise);
+  const Transform2d to_prior = error.inverse();
+  Case c;
+  c.truth = kOrigin + kVehicle;
+  c.prior = to_prior.apply(c.truth);
+  for (size_t i = 0; i < map.size(); i += kScanStride) {
+    if ((map[i] - c.truth).norm() > kScanRange) continue;
+    c.curbs_world.push_back(to_prior.apply(map[i] + Eigen::Vector2d(noise(rng), noise(rng))));
+  }
+  return c;
+}
+
+// Position error at the vehicle (the pose correction's meaning) and heading error.
+void expect_recovered(const FmtResult& r, const Case& c, const Transform2d& error) {
+  ASSERT_TRUE(r.ok) << "response " << r.response;
+  const Eigen::Vector2d corrected = r.correction.apply(c.prior);
+  EXPECT_NEAR(corrected.x(), c.truth.x(), kPositionTolerance);
+  EXPECT_NEAR(corrected.y(), c.truth.y(), kPositionTolerance);
+  EXPECT_NEAR(wrap_angle(r.correction.theta - error.theta), 0.0, kHeadingTolerance)
+      << "heading " << r.correction.theta / kDeg << " deg";
+}
+
+TEST(FmtMatcher, RecoversTranslationAndRotation) {
+  const auto map = junction_map();
+  const Transform2d error{0.6, -0.4, 2.0 * kDeg};
+  const Case c = make_case(map, error);
+  const FmtResult r = fmt_match(c.curbs_world, map, c.prior);
+  expect_recovered(r, c, error);
+  EXPECT_GT(r.response, FmtParams{}.min_response);
+}
+
+TEST(FmtMatcher, RecoversPureTranslationToOneCell) {
+  const auto map = junction_map();
+  const Transform2d error{1.3, -0.7, 0.0};
+  const Case c = make_case(map, error);
+  const FmtResult r = fmt_match(c.curbs_world, map, c.prior);
+  ASSERT_TRUE(r.ok);
+  const double cell = FmtParams{}.cell_m;
+  const Eigen::Vector2d corrected = r.correction.apply(c.prior);
+  EXPECT_NEAR(corrected.x(), c.truth.x(), cell);
+  EXPECT_NEAR(corrected.y(), c.truth.y(), cell);
+  EXPECT_NEAR(r.correction.theta, 0.0, kHeadingTolerance);
+}
+
+// Each axis and the rotation on its own, with the sign that a swap of x and y, of the image's row
+// direction, or of the rotation's sense would get wrong.
+TEST(FmtMatcher, SignConventions) {
+  const auto map = junction_map();
+  constexpr double kShift = 0.8, kTurn = 3.0 * kDeg;
+  for (const Transform2d error : {Transform2d{kShift, 0, 0}, Transform2d{0, kShift, 0}, Transform2d{0, 0, kTurn},
+                                  Transform2d{0, 0, -kTurn}}) {
+    SCOPED_TRACE(testing::Message() << "error " << error.x << ", " << error.y << ", " << error.theta / kDeg);
+    const Case c = make_case(map, error);
+    const FmtResult r = fmt_match(c.curbs_world, map, c.prior);
+    expect_recovered(r, c, error);
+    // The transform itself, not only its effect at the prior: the curbs must land on the map.
+    const Transform2d residual = r.correction.compose(error.inverse());
+    const Eigen::Vector2d far_point = c.prior + Eigen::Vector2d(kScanRange, kScanRange);
+    EXPECT_LT((residual.apply(far_point) - far_point).norm(), 2 * kPositionTolerance);
+  }
+}
+
+// A heading off by nearly a half turn: the magnitude spectrum cannot tell it from a small one, the
+// translation step (the side road is on one side only) must.
+TEST(FmtMatcher, ResolvesTheHalfTurnAmbiguity) {
+  const auto map = junction_map();
+  const Transform2d error{-0.5, 0.3, 175.0 * kDeg};
+  const Case c = make_case(map, error);
+  expect_recovered(fmt_match(c.curbs_world, map, c.prior), c, error);
+}
+
+TEST(FmtMatcher, RefusesEmptyAndNonFiniteInput) {
+  const auto map = junction_map();
+  const Case c = make_case(map, {0.6, -0.4, 2.0 * kDeg});
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(fmt_match({}, map, c.prior).ok);
+  EXPECT_FALSE(fmt_match(c.curbs_world, {}, c.prior).ok);
+  EXPECT_FALSE(fmt_match({}, {}, c.prior).ok);
+  EXPECT_FALSE(fmt_match(std::vector<Eigen::Vector2d>(100, Eigen::Vector2d(nan, 1.0)), map, c.prior).ok);
+  EXPECT_FALSE(fmt_match(c.curbs_world, map, Eigen::Vector2d(nan, 0.0)).ok);
+  EXPECT_FALSE(fmt_match(c.curbs_world, map, Eigen::Vector2d(std::numeric_limits<double>::infinity(), 0.0)).ok);
+  // Too few points (all else fine), and every curb off the grid.
+  const std::vector<Eigen::Vector2d> few(c.curbs_world.begin(), c.curbs_world.begin() + 3);
+  EXPECT_FALSE(fmt_match(few, map, c.prior).ok);
+  EXPECT_FALSE(fmt_match(c.curbs_world, map, c.prior + Eigen::Vector2d(1000, 0)).ok);
+
+  // A few non-finite curbs among good ones are skipped, not fatal.
+  auto dirty = c.curbs_world;
+  dirty.emplace_back(nan, 0.0);
+  dirty.emplace_back(0.0, std::numeric_limits<double>::infinity());
+  EXPECT_TRUE(fmt_match(dirty, map, c.prior).ok);
+}
+
+// Curbs that have nothing to do with the map must not pass as a match.
+TEST(FmtMatcher, RejectsUnrelatedCurbs) {
+  const auto map = junction_map();
+  const Case c = make_case(map, {});
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-kScanRange, kScanRange);
+  std::vector<Eigen::Vector2d> scatter;
+  for (size_t i = 0; i < c.curbs_world.size(); ++i) scatter.push_back(c.prior + Eigen::Vector2d(u(rng), u(rng)));
+  const FmtResult r = fmt_match(scatter, map, c.prior);
+  EXPECT_FALSE(r.ok) << "response " << r.response;
+  EXPECT_LT(r.response, FmtParams{}.min_response);
+}
+
+TEST(FmtMatcher, RejectsBadParams) {
+  const std::vector<Eigen::Vector2d> pts{{0, 0}};
+  const auto bad = [&](auto change) {
+    FmtParams p;
+    change(p);
+    EXPECT_THROW(fmt_match(pts, pts, {0, 0}, p), std::invalid_argument);
+  };
+  bad([](FmtParams& p) { p.size_cells = 4; });
+  bad([](FmtParams& p) { p.cell_m = 0; });
+  bad([](FmtParams& p) { p.cell_m = std::numeric_limits<double>::quiet_NaN(); });
+  bad([](FmtParams& p) { p.blur_sigma_cells = -1; });
+  bad([](FmtParams& p) { p.angle_bins = 2; });
+  bad([](FmtParams& p) { p.min_radius_fraction = 0.6; });
+  bad([](FmtParams& p) { p.max_radius_fraction = 1.5; });
+  bad([](FmtParams& p) { p.min_points = 0; });
+  bad([](FmtParams& p) { p.min_response = 2; });
+}
+
+}  // namespace
+}  // namespace lidarloop

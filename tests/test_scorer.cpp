@@ -1,0 +1,382 @@
+// The scorer, the result files and the plots, on inputs whose errors are known by construction.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/input_error.hpp"
+#include "tools/error_plots.hpp"
+#include "tools/result_files.hpp"
+#include "tools/scorer.hpp"
+
+namespace lidarloop {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kEps = 1e-12;
+constexpr int64_t kMs = 1'000'000;
+
+// A straight drive east at 10 m/s, 100 Hz, for `seconds`.
+std::vector<TruthPose> straight_truth(double seconds) {
+  std::vector<TruthPose> truth;
+  for (int64_t t = 0; t <= int64_t(seconds * 1000) * kMs; t += 10 * kMs)
+    truth.push_back({t, {10.0 * double(t) / 1e9, 0, 0}});
+  return truth;
+}
+
+// Estimates at 10 Hz offset from the straight truth by (longitudinal, lateral, heading).
+std::vector<EstimateRecord> offset_estimates(double seconds, double lon, double lat, double yaw,
+                                             double latency_ms = 5) {
+  std::vector<EstimateRecord> out;
+  for (int64_t t = 0; t <= int64_t(seconds * 1000) * kMs; t += 100 * kMs) {
+    EstimateRecord e;
+    e.stamp_ns = t;
+    e.pose = {10.0 * double(t) / 1e9 + lon, lat, yaw};
+    e.covariance = Eigen::Vector3d(0.04, 0.09, 0.0001).asDiagonal();
+    e.status = "tracking";
+    e.latency_ms = latency_ms;
+    out.push_back(e);
+  }
+  return out;
+}
+
+std::string temp_path(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / "lidarloop_test_scorer";
+  std::filesystem::create_directories(dir);
+  return (dir / name).string();
+}
+
+std::string read_all(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+const char* const kUnwritableDir = "/nonexistent_lidarloop_dir";
+
+TEST(FrameError, DisplacementAlongHeadingIsLongitudinal) {
+  for (double yaw : {0.0, 0.7, kPi / 2, 2.5, -kPi / 2, -3.0}) {
+    const Pose2d truth{3, -4, yaw};
+    const Pose2d ahead{3 + std::cos(yaw), -4 + std::sin(yaw), yaw};
+    const FrameError e = frame_error(truth, ahead);
+    EXPECT_NEAR(e.longitudinal_m, 1, kEps) << yaw;
+    EXPECT_NEAR(e.lateral_m, 0, kEps) << yaw;
+    EXPECT_NEAR(e.heading_rad, 0, kEps) << yaw;
+    EXPECT_NEAR(e.position_m, 1, kEps) << yaw;
+  }
+}
+
+TEST(FrameError, LeftDisplacementIsPositiveLateral) {
+  for (double yaw : {0.0, 1.0, -2.0, kPi}) {
+    const Pose2d truth{1, 2, yaw};
+    const Pose2d left{1 - 0.5 * std::sin(yaw), 2 + 0.5 * std::cos(yaw), yaw};
+    const FrameError e = frame_error(truth, left);
+    EXPECT_NEAR(e.lateral_m, 0.5, kEps) << yaw;
+    EXPECT_NEAR(e.longitudinal_m, 0, kEps) << yaw;
+  }
+}
+
+TEST(FrameError, HeadingWrapsAcrossPi) {
+  const FrameError e = frame_error({0, 0, kPi - 0.1}, {0, 0, -kPi + 0.1});
+  EXPECT_NEAR(e.heading_rad, 0.2, kEps);
+  EXPECT_NEAR(frame_error({0, 0, -kPi + 0.05}, {0, 0, kPi - 0.05}).heading_rad, -0.1, kEps);
+  EXPECT_NEAR(frame_error({0, 0, 0}, {0, 0, 4 * kPi + 0.3}).heading_rad, 0.3, kEps);
+}
+
+TEST(TruthAt, InterpolatesMidwayAndAtSamples) {
+  const std::vector<TruthPose> truth = {{0, {0, 0, 0.1}}, {10 * kMs, {1, 2, 0.3}}, {20 * kMs, {3, 2, 0.3}}};
+  const Pose2d mid = truth_at(truth, 5 * kMs);
+  EXPECT_NEAR(mid.x, 0.5, kEps);
+  EXPECT_NEAR(mid.y, 1.0, kEps);
+  EXPECT_NEAR(mid.yaw, 0.2, kEps);
+  EXPECT_NEAR(truth_at(truth, 10 * kMs).x, 1, kEps);
+  EXPECT_NEAR(truth_at(truth, 20 * kMs).x, 3, kEps);
+  EXPECT_NEAR(truth_at(truth, 0).yaw, 0.1, kEps);
+}
+
+TEST(TruthAt, InterpolatesYawAcrossTheWrap) {
+  const std::vector<TruthPose> truth = {{0, {0, 0, kPi - 0.1}}, {10 * kMs, {0, 0, -kPi + 0.1}}};
+  const Pose2d mid = truth_at(truth, 5 * kMs);
+  EXPECT_NEAR(std::abs(mid.yaw), kPi, 1e-9);  // through pi, not through 0
+  const Pose2d quarter = truth_at(truth, 2'500'000);
+  EXPECT_NEAR(quarter.yaw, kPi - 0.05, 1e-9);
+}
+
+TEST(TruthAt, ThrowsOutsideRangeOrEmpty) {
+  const std::vector<TruthPose> truth = {{10, {}}, {20, {}}};
+  EXPECT_THROW(truth_at(truth, 9), std::out_of_range);
+  EXPECT_THROW(truth_at(truth, 21), std::out_of_range);
+  EXPECT_THROW(truth_at({}, 0), std::out_of_range);
+}
+
+TEST(Score, RmseOfConstantKnownErrors) {
+  const ScoredRun run = score(straight_truth(5), offset_estimates(5, 0.3, -0.2, 0.01), {}, "test", "straight");
+  const Metrics& m = run.metrics;
+  EXPECT_EQ(m.frames, 51u);
+  EXPECT_EQ(run.errors.size(), 51u);
+  EXPECT_NEAR(m.longitudinal_rmse_m, 0.3, 1e-9);
+  EXPECT_NEAR(m.lateral_rmse_m, 0.2, 1e-9);
+  EXPECT_NEAR(m.heading_rmse_deg, 0.01 * 180 / kPi, 1e-9);
+  EXPECT_NEAR(m.max_position_error_m, std::hypot(0.3, 0.2), 1e-9);
+  EXPECT_NEAR(m.max_lateral_m, 0.2, 1e-9);
+  EXPECT_NEAR(run.errors.front().lateral_m, -0.2, 1e-9);  // to the right: negative
+  EXPECT_TRUE(m.pass);  // no thresholds set
+  EXPECT_TRUE(m.failures.empty());
+}
+
+TEST(Score, RmseOfAlternatingErrors) {
+  std::vector<EstimateRecord> est = offset_estimates(1, 0, 0, 0);
+  for (size_t i = 0; i < est.size(); ++i) est[i].pose.y = (i % 2 ? 0.3 : -0.3);
+  EXPECT_NEAR(score(straight_truth(1), est, {}, "m", "s").metrics.lateral_rmse_m, 0.3, 1e-9);
+  EXPECT_NEAR(rmse({3, 4}), std::sqrt(12.5), kEps);
+  EXPECT_TRUE(std::isnan(rmse({})));
+}
+
+TEST(Score, NearestRankPercentiles) {
+  const std::vector<double> v = {15, 20, 35, 40, 50};  // the textbook nearest-rank example
+  EXPECT_EQ(percentile_nearest_rank(v, 5), 15);
+  EXPECT_EQ(percentile_nearest_rank(v, 30), 20);
+  EXPECT_EQ(percentile_nearest_rank(v, 40), 20);
+  EXPECT_EQ(percentile_nearest_rank(v, 50), 35);
+  EXPECT_EQ(percentile_nearest_rank(v, 100), 50);
+  EXPECT_EQ(percentile_nearest_rank(v, 0), 15);
+  std::vector<double> hundred;
+  for (int i = 100; i >= 1; --i) hundred.push_back(i);  // unsorted input
+  EXPECT_EQ(percentile_nearest_rank(hundred, 99), 99);
+  EXPECT_EQ(percentile_nearest_rank(hundred, 50), 50);
+  EXPECT_TRUE(std::isnan(percentile_nearest_rank({}, 50)));
+
+  std::vector<EstimateRecord> est = offset_estimates(9.9, 0, 0, 0);  // 100 frames
+  ASSERT_EQ(est.size(), 100u);
+  for (size_t i = 0; i < est.size(); ++i) est[i].latency_ms = double(i + 1);
+  const Metrics m = score(straight_truth(10), est, {}, "m", "s").metrics;
+  EXPECT_EQ(m.latency_p50_ms, 50);
+  EXPECT_EQ(m.latency_p99_ms, 99);
+  EXPECT_EQ(m.latency_max_ms, 100);
+}
+
+TEST(Score, EachThresholdTripsOnItsOwn) {
+  const auto truth = straight_truth(3);
+  const auto est = offset_estimates(3, 0.3, 0.2, 0.01);  // 0.2 m lateral, 0.3 m long, 0.573 deg, 0.361 m
+  const PassThresholds loose{1.0, 1.0, 1.0, 1.0};
+  EXPECT_TRUE(score(truth, est, loose, "m", "s").metrics.pass);
+
+  auto trip = [&](PassThresholds t, const std::string& expected) {
+    const Metrics m = score(truth, est, t, "m", "s").metrics;
+    EXPECT_FALSE(m.pass) << expected;
+    ASSERT_EQ(m.failures.size(), 1u) << expected;
+    EXPECT_EQ(m.failures[0], expected);
+  };
+  PassThresholds t = loose;
+  t.lateral_rmse_m = 0.1;
+  trip(t, "lateral RMSE 0.200 m > 0.100 m");
+  t = loose;
+  t.longitudinal_rmse_m = 0.25;
+  trip(t, "longitudinal RMSE 0.300 m > 0.250 m");
+  t = loose;
+  t.heading_rmse_deg = 0.5;
+  trip(t, "heading RMSE 0.573 deg > 0.500 deg");
+  t = loose;
+  t.max_position_error_m = 0.3;
+  trip(t, "max position error 0.361 m > 0.300 m");
+}
+
+TEST(Score, NoEstimatesFails) {
+  const Metrics m = score(straight_truth(1), {}, {}, "m", "s").metrics;
+  EXPECT_EQ(m.frames, 0u);
+  EXPECT_FALSE(m.pass);
+  ASSERT_EQ(m.failures.size(), 1u);
+  EXPECT_EQ(m.failures[0], "no estimates");
+}
+
+TEST(Score, EstimatesOutsideTruthAreCountedNotScored) {
+  auto est = offset_estimates(2, 0.1, 0, 0);
+  const Metrics m = score(straight_truth(1), est, {}, "m", "s").metrics;
+  EXPECT_EQ(m.frames, 11u);
+  EXPECT_EQ(m.unscored_frames, 10u);
+  EXPECT_TRUE(m.pass);
+  EXPECT_FALSE(score({}, est, {}, "m", "s").metrics.pass);
+}
+
+TEST(Score, DivergedEstimateFails) {
+  auto est = offset_estimates(1, 0, 0, 0);
+  est[3].pose.x = std::nan("");
+  const Metrics m = score(straight_truth(1), est, PassThresholds{1.0, 1.0, 1.0, 1.0}, "m", "s").metrics;
+  EXPECT_FALSE(m.pass);
+}
+
+TEST(ResultFiles, MetricsJsonRoundTrip) {
+  PassThresholds t;
+  t.lateral_rmse_m = 0.1;
+  t.heading_rmse_deg = 0.3;
+  const Metrics m = score(straight_truth(2), offset_estimates(2, 0.3, 0.2, 0.01, 7.5), t, "proposed", "dyn").metrics;
+  const std::string path = temp_path("metrics.json");
+  write_metrics_json(path, m);
+  const auto j = nlohmann::json::parse(read_all(path));
+  EXPECT_EQ(j["method"], "proposed");
+  EXPECT_EQ(j["scenario"], "dyn");
+  EXPECT_EQ(j["frames"], m.frames);
+  EXPECT_DOUBLE_EQ(j["lateral_rmse_m"].get<double>(), m.lateral_rmse_m);
+  EXPECT_DOUBLE_EQ(j["longitudinal_rmse_m"].get<double>(), m.longitudinal_rmse_m);
+  EXPECT_DOUBLE_EQ(j["heading_rmse_deg"].get<double>(), m.heading_rmse_deg);
+  EXPECT_DOUBLE_EQ(j["max_position_error_m"].get<double>(), m.max_position_error_m);
+  EXPECT_DOUBLE_EQ(j["latency_p50_ms"].get<double>(), 7.5);
+  EXPECT_DOUBLE_EQ(j["latency_p99_ms"].get<double>(), 7.5);
+  EXPECT_EQ(j["pass"], false);
+  EXPECT_DOUBLE_EQ(j["thresholds"]["lateral_rmse_m"].get<double>(), 0.1);
+  EXPECT_TRUE(j["thresholds"]["longitudinal_rmse_m"].is_null());
+  ASSERT_EQ(j["failures"].size(), 2u);
+  EXPECT_EQ(j["failures"][0], m.failures[0]);
+
+  // Undefined values (no frames) are null, not an invalid NaN token.
+  const auto empty = nlohmann::json::parse(metrics_json(score({}, {}, {}, "gps", "s").metrics));
+  EXPECT_TRUE(empty["lateral_rmse_m"].is_null());
+}
+
+TEST(ResultFiles, TumLineFormat) {
+  EXPECT_EQ(tum_line(1'500'000'000, {1.25, -2.5, 0}), "1.500000000 1.25 -2.5 0 0 0 0 1");
+  std::istringstream in(tum_line(123'456'789'012, {1234.56789012, 0.1, kPi / 2}));
+  std::vector<double> v;
+  for (double x; in >> x;) v.push_back(x);
+  ASSERT_EQ(v.size(), 8u);
+  EXPECT_DOUBLE_EQ(v[0], 123.456789012);
+  EXPECT_NEAR(v[1], 1234.56789, 1e-9);  // 9 significant digits
+  EXPECT_EQ(v[3], 0);
+  EXPECT_NEAR(v[6], std::sin(kPi / 4), 1e-9);
+  EXPECT_NEAR(v[7], std::cos(kPi / 4), 1e-9);
+
+  const std::string path = temp_path("truth.tum");
+  write_tum(path, straight_truth(1));
+  std::ifstream file(path);
+  std::string line;
+  std::getline(file, line);
+  EXPECT_EQ(line[0], '#');
+  size_t lines = 0;
+  while (std::getline(file, line)) ++lines;
+  EXPECT_EQ(lines, 101u);
+  write_tum(temp_path("estimate.tum"), offset_estimates(1, 0, 0, 0));
+}
+
+TEST(ResultFiles, JunitHasFailureExactlyWhenFailing) {
+  PassThresholds t;
+  t.lateral_rmse_m = 0.1;
+  const auto truth = straight_truth(1);
+  const Metrics good = score(truth, offset_estimates(1, 0, 0.05, 0), t, "proposed", "a<&>\"b").metrics;
+  const Metrics bad = score(truth, offset_estimates(1, 0, 0.5, 0), t, "icp", "a<&>\"b").metrics;
+  const Metrics other = score(truth, offset_estimates(1, 0, 0.05, 0), t, "gps", "static").metrics;
+  const std::string pass_xml = junit_xml({good, other});
+  EXPECT_EQ(pass_xml.find("<failure"), std::string::npos);
+  const std::string xml = junit_xml({good, bad, other});
+  EXPECT_NE(xml.find("<failure message=\"lateral RMSE 0.500 m &gt; 0.100 m\""), std::string::npos) << xml;
+  EXPECT_EQ(xml.find("<failure"), xml.rfind("<failure"));  // only one
+  EXPECT_NE(xml.find("<testsuite name=\"a&lt;&amp;&gt;&quot;b\" tests=\"2\" failures=\"1\""), std::string::npos)
+      << xml;
+  EXPECT_NE(xml.find("<testsuite name=\"static\" tests=\"1\" failures=\"0\""), std::string::npos);
+  EXPECT_EQ(xml.find("a<&>"), std::string::npos);
+  write_junit(temp_path("junit.xml"), {good, bad});
+}
+
+TEST(ResultFiles, ComparisonTableAndCsv) {
+  const auto truth = straight_truth(1);
+  PassThresholds t;
+  t.lateral_rmse_m = 0.1;
+  const std::vector<Metrics> runs = {score(truth, offset_estimates(1, 0.1, 0.05, 0), t, "proposed", "s").metrics,
+                                     score(truth, offset_estimates(1, 2.5, 0.5, 0), t, "icp", "s").metrics};
+  const std::string md = comparison_markdown(runs);
+  EXPECT_NE(md.find("| method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | max error m | latency p50 ms"),
+            std::string::npos);
+  EXPECT_NE(md.find("| proposed | 0.050 | 0.100 | 0.000 | 0.112 | 5.00 | pass |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| icp | 0.500 | 2.500 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("FAIL"), std::string::npos);
+  const std::string path = temp_path("compare.csv");
+  write_comparison_csv(path, runs);
+  const std::string csv = read_all(path);
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "scenario,method,frames,lateral_rmse_m,longitudinal_rmse_m,heading_rmse_deg,max_position_error_m,"
+            "latency_p50_ms,latency_p99_ms,pass");
+  EXPECT_NE(csv.find("s,icp,11,0.5,2.5,0,"), std::string::npos) << csv;
+}
+
+TEST(ResultFiles, ErrorsCsvHasOneLinePerScoredFrame) {
+  const auto est = offset_estimates(2, 0.3, 0.2, 0);
+  const ScoredRun run = score(straight_truth(1), est, {}, "m", "s");
+  const std::string path = temp_path("errors.csv");
+  write_errors_csv(path, run, est);
+  std::ifstream in(path);
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header.substr(0, 46), "t_s,lateral_m,longitudinal_m,heading_deg,posit");
+  std::vector<std::string> lines;
+  while (std::getline(in, line)) lines.push_back(line);
+  ASSERT_EQ(lines.size(), run.errors.size());
+  EXPECT_EQ(lines[1].substr(0, lines[1].find(",tracking")), "0.100000000,0.2,0.3,0,0.360555128,1.3,0.2,0,1,0,0");
+  EXPECT_NE(lines[1].find(",tracking,5,0.2,0.3,"), std::string::npos) << lines[1];
+}
+
+TEST(ResultFiles, UnwritablePathThrowsNamingIt) {
+  const std::string dir = kUnwritableDir;
+  const Metrics m = score(straight_truth(1), offset_estimates(1, 0, 0, 0), {}, "m", "s").metrics;
+  auto expect_names = [&](const std::function<void(const std::string&)>& write, const std::string& name) {
+    const std::string path = dir + "/" + name;
+    try {
+      write(path);
+      ADD_FAILURE() << name << " did not throw";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  };
+  expect_names([&](const std::string& p) { write_metrics_json(p, m); }, "metrics.json");
+  expect_names([&](const std::string& p) { write_errors_csv(p, {}, {}); }, "errors.csv");
+  expect_names([&](const std::string& p) { write_tum(p, straight_truth(1)); }, "truth.tum");
+  expect_names([&](const std::string& p) { write_junit(p, {m}); }, "junit.xml");
+  expect_names([&](const std::string& p) { write_comparison_csv(p, {m}); }, "compare.csv");
+  expect_names([&](const std::string& p) { write_error_plot(p, {}); }, "errors.png");
+  expect_names([&](const std::string& p) { write_trajectory_plot(p, {}, {}, {}); }, "trajectory.png");
+}
+
+TEST(ErrorPlots, WritePngsOfTheRequestedSize) {
+  // A lane change and back, with a growing longitudinal error, on an S-curve.
+  std::vector<TruthPose> truth;
+  for (int64_t t = 0; t <= 20'000 * kMs; t += 10 * kMs) {
+    const double s = double(t) / 1e9;
+    truth.push_back({t, {10 * s, 20 * std::sin(s / 4), std::atan2(5 * std::cos(s / 4), 10.0)}});
+  }
+  std::vector<EstimateRecord> est;
+  for (int64_t t = 0; t <= 20'000 * kMs; t += 100 * kMs) {
+    const double s = double(t) / 1e9;
+    const Pose2d p = truth_at(truth, t);
+    EstimateRecord e;
+    e.stamp_ns = t;
+    e.pose = {p.x + 0.02 * s, p.y + 0.3 * std::sin(s), p.yaw + 0.01 * std::cos(s)};
+    est.push_back(e);
+  }
+  const ScoredRun run = score(truth, est, {}, "m", "s");
+  const Polyline2d curb = {{0, -5}, {100, -5}, {200, -5}};
+
+  const std::string errors_png = temp_path("errors.png"), trajectory_png = temp_path("trajectory.png");
+  write_error_plot(errors_png, run.errors);
+  write_trajectory_plot(trajectory_png, truth, est, run.errors, {curb});
+  for (const auto& path : {errors_png, trajectory_png}) {
+    EXPECT_GT(std::filesystem::file_size(path), 0u);
+    const cv::Mat image = cv::imread(path);
+    ASSERT_FALSE(image.empty()) << path;
+    EXPECT_EQ(image.cols, 1200);
+    EXPECT_EQ(image.rows, 900);
+  }
+  // Other sizes, and degenerate inputs draw rather than crash.
+  write_error_plot(errors_png, {}, {800, 600});
+  EXPECT_EQ(cv::imread(errors_png).cols, 800);
+  write_trajectory_plot(trajectory_png, {}, {}, {}, {}, {640, 480});
+  EXPECT_EQ(cv::imread(trajectory_png).rows, 480);
+  EXPECT_THROW(write_error_plot(errors_png, run.errors, {100, 100}), InputError);
+}
+
+}  // namespace
+}  // namespace lidarloop
