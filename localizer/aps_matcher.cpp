@@ -179,7 +179,10 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
   // Normalise by the best offset before exponentiating: the raw sums are thousands, exp() would be 0.
   std::vector<double> log_p(sum_sq.size());
   for (size_t k = 0; k < sum_sq.size(); ++k) log_p[k] = -0.5 * params.alpha * double(sum_sq[k]);
-  const double best = *std::max_element(log_p.begin(), log_p.end());
+  const auto best_at = std::max_element(log_p.begin(), log_p.end());
+  const double best = *best_at;
+  const int best_i = int((best_at - log_p.begin()) % ox), best_j = int((best_at - log_p.begin()) / ox);
+  result.peak_on_edge = (nx > 0 && (best_i == 0 || best_i == ox - 1)) || (ny > 0 && (best_j == 0 || best_j == oy - 1));
   double total = 0;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   Eigen::Matrix2d second = Eigen::Matrix2d::Zero();

@@ -67,6 +67,9 @@ struct ApsResult {
   // observation noise for the Kalman filter. When !ok: that of a uniform spread over the window.
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();
   int cells_used = 0;  // cells of S that entered Eq. 14
+  // The most probable offset lies on the window's border: the true one may well be outside, and the
+  // centroid is then pulled towards the middle of a window that does not contain it.
+  bool peak_on_edge = false;
 };
 
 // APS over the window of offsets around S.pose. A cell of S takes part only if S_n > n_e and the map

@@ -13,16 +13,19 @@ namespace lidarloop {
 namespace {
 
 // Smallest grid accepted: phaseCorrelate takes a 5 x 5 centroid around its peak, and a spectrum of a
-// few cells has no angular resolution to speak of.
-constexpr int kMinSizeCells = 16;
-constexpr int kMinAngleBins = 8;
+// few cells has no angular resolution to speak of. Largest: a typo must not allocate gigabytes (a
+// 4096-cell grid is 64 MB per float image; the paper's is 500).
+constexpr int kMinSizeCells = 16, kMaxSizeCells = 4096;
+constexpr int kMinAngleBins = 8, kMaxAngleBins = 36000;  // up to 0.005 degree bins
 
 void validate(const FmtParams& p) {
-  if (p.size_cells < kMinSizeCells) throw std::invalid_argument("fmt_match: size_cells must be >= 16");
+  if (p.size_cells < kMinSizeCells || p.size_cells > kMaxSizeCells)
+    throw std::invalid_argument("fmt_match: size_cells must be 16 to 4096");
   if (!(p.cell_m > 0) || !std::isfinite(p.cell_m)) throw std::invalid_argument("fmt_match: cell_m must be > 0");
   if (!(p.blur_sigma_cells >= 0) || !std::isfinite(p.blur_sigma_cells))
     throw std::invalid_argument("fmt_match: blur_sigma_cells must be >= 0");
-  if (p.angle_bins < kMinAngleBins) throw std::invalid_argument("fmt_match: angle_bins must be >= 8");
+  if (p.angle_bins < kMinAngleBins || p.angle_bins > kMaxAngleBins)
+    throw std::invalid_argument("fmt_match: angle_bins must be 8 to 36000");
   if (!(p.min_radius_fraction >= 0) || !(p.max_radius_fraction <= 1) ||
       !(p.min_radius_fraction < p.max_radius_fraction))
     throw std::invalid_argument("fmt_match: need 0 <= min_radius_fraction < max_radius_fraction <= 1");

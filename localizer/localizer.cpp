@@ -276,18 +276,41 @@ void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, Locali
   world.reserve(features.size());
   for (const auto& f : features) world.push_back(to_world(prior, f));
 
+  // Correspondences as far as the prior is uncertain (see icp_window_sigmas).
+  const double sigma = std::sqrt(filter_->covariance().topLeftCorner<2, 2>().eigenvalues().real().maxCoeff());
+  auto widened = [&](IcpParams p) {
+    p.max_correspondence =
+        std::max(p.max_correspondence, std::min(params_.icp_window_sigmas * sigma, params_.icp_max_correspondence_m));
+    return p;
+  };
   Transform2d t;
   switch (params_.method) {
-    case LocalizerMethod::proposed:
-      t = probabilistic_icp(map_index_, world, {}, params_.probabilistic_icp, rng_).t;
+    case LocalizerMethod::proposed: {
+      ProbabilisticIcpParams p = params_.probabilistic_icp;
+      p.local = widened(p.local);  // the global ICP keeps d_g
+      t = probabilistic_icp(map_index_, world, {}, p, rng_).t;
       break;
+    }
     case LocalizerMethod::icp:
     case LocalizerMethod::icp_obs:
-      t = icp(map_index_, world, {}, params_.icp).t;
+      t = icp(map_index_, world, {}, widened(params_.icp)).t;
       break;
-    case LocalizerMethod::m_icp:
-      t = m_icp(map_index_, world, {}, params_.m_icp).t;
+    case LocalizerMethod::m_icp: {
+      MIcpParams p = params_.m_icp;
+      p.icp = widened(p.icp);
+      t = m_icp(map_index_, world, {}, p).t;
       break;
+    }
+    case LocalizerMethod::fmt: {
+      const FmtResult f = fmt_match(world, map_.curbs.window(xy(prior), params_.map_window_m), xy(prior), params_.fmt);
+      if (!f.ok) {
+        e.stage_ms[size_t(Stage::curb_matching)] += watch.lap_ms();
+        e.health |= kCurbMatchRejected;
+        return;
+      }
+      t = f.correction;
+      break;
+    }
     default:
       return;
   }
@@ -314,16 +337,38 @@ void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, Locali
 void Localizer::match_intensity(const std::vector<Eigen::Vector3d>& ground, const std::vector<double>& intensities,
                                 LocalizerEstimate& e) {
   Stopwatch watch;
-  const IntensityGrid S = build_intensity_grid(ground, intensities, filter_->pose(), params_.intensity_grid);  // Eq. 8
-  const ApsResult aps = aps_match(S, map_.intensity, params_.aps);  // Eq. 14-18
+  const Pose2d prior = filter_->pose();
+  // The prior's spread along and across the car sets the search window (see aps_window_sigmas).
+  const double c = std::cos(prior.yaw), s = std::sin(prior.yaw);
+  Eigen::Matrix2d to_vehicle;
+  to_vehicle << c, s, -s, c;
+  const Eigen::Matrix2d spread = to_vehicle * filter_->covariance().topLeftCorner<2, 2>() * to_vehicle.transpose();
+  ApsParams aps_params = params_.aps;
+  auto window = [&](double variance, double paper_range) {
+    const double wanted = params_.aps_window_sigmas * std::sqrt(std::max(variance, 0.0));
+    // Whole steps, so the window stays symmetric about the prior.
+    return std::ceil(std::max(paper_range, wanted) / aps_params.step_m) * aps_params.step_m;
+  };
+  aps_params.longitudinal_range_m = window(spread(0, 0), params_.aps.longitudinal_range_m);
+  aps_params.lateral_range_m = window(spread(1, 1), params_.aps.lateral_range_m);
+  if (aps_params.longitudinal_range_m > params_.aps_max_longitudinal_range_m + 1e-9 ||
+      aps_params.lateral_range_m > params_.aps_max_lateral_range_m + 1e-9) {
+    e.health |= kIntensityMatchRejected;  // the prior is too vague for a local search
+    return;
+  }
+  const IntensityGrid S = build_intensity_grid(ground, intensities, prior, params_.intensity_grid);  // Eq. 8
+  const ApsResult aps = aps_match(S, map_.intensity, aps_params);  // Eq. 14-18
   e.intensity_cells = aps.cells_used;
   e.stage_ms[size_t(Stage::intensity_matching)] += watch.lap_ms();
   if (!aps.ok) {
     e.health |= kNoIntensityMatch;
     return;
   }
+  if (aps.peak_on_edge) {
+    e.health |= kIntensityMatchRejected;
+    return;
+  }
   e.intensity_observation = aps.position;
-  const Pose2d prior = filter_->pose();
   const Eigen::Vector2d innovation = aps.position - xy(prior);
   const Eigen::Matrix2d S2 = filter_->covariance().topLeftCorner<2, 2>() + aps.covariance;
   if (!gate(innovation.dot(S2.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {

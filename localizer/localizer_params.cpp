@@ -91,6 +91,11 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   top.section("method").boolean("deskew", p.deskew).number("map_window_m", p.map_window_m, 5.0, 200.0);
   top.number("max_prediction_step_s", p.max_prediction_step_s, 1e-4, 0.1);
   top.number("process_position_without_can_per_s", p.process_position_without_can_per_s, 0.0, 100.0);
+  top.number("aps_window_sigmas", p.aps_window_sigmas, 0.0, 100.0);
+  top.number("icp_window_sigmas", p.icp_window_sigmas, 0.0, 100.0);
+  top.number("icp_max_correspondence_m", p.icp_max_correspondence_m, 0.1, 100.0);
+  top.number("aps_max_lateral_range_m", p.aps_max_lateral_range_m, 0.0, 50.0);
+  top.number("aps_max_longitudinal_range_m", p.aps_max_longitudinal_range_m, 0.0, 50.0);
   if (const YAML::Node m = node["method"]) {
     try {
       p.method = parse_localizer_method(y.string(m, "method"));
@@ -158,6 +163,17 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
         .done();
     if (n) read_icp(y, n["icp"], "icp", p.m_icp.icp);
   }
+  top.section("fmt");
+  Section(y, node["fmt"], "fmt")
+      .integer("size_cells", p.fmt.size_cells, 16, 4096)
+      .number("cell_m", p.fmt.cell_m, 0.01, 2.0)
+      .number("blur_sigma_cells", p.fmt.blur_sigma_cells, 0.0, 20.0)
+      .integer("angle_bins", p.fmt.angle_bins, 8, 7200)
+      .number("min_radius_fraction", p.fmt.min_radius_fraction, 0.0, 1.0)
+      .number("max_radius_fraction", p.fmt.max_radius_fraction, 0.0, 1.0)
+      .integer("min_points", p.fmt.min_points, 1, 100000)
+      .number("min_response", p.fmt.min_response, 0.0, 1.0)
+      .done();
   top.section("intensity_grid");
   Section(y, node["intensity_grid"], "intensity_grid")
       .integer("width_cells", p.intensity_grid.width_cells, 10, 4000)

@@ -14,6 +14,7 @@
 #include "localizer/curb_features.hpp"
 #include "localizer/curb_match_covariance.hpp"
 #include "localizer/driving_corridor.hpp"
+#include "localizer/fmt_matcher.hpp"
 #include "localizer/obstacle_rejection.hpp"
 #include "localizer/pose_filter.hpp"
 #include "localizer/probabilistic_icp.hpp"
@@ -79,8 +80,17 @@ struct LocalizerParams {
   ProbabilisticIcpParams probabilistic_icp;
   IcpParams icp;   // the icp and icp-obs baselines
   MIcpParams m_icp;
+  FmtParams fmt;
   IntensityGridParams intensity_grid;
   ApsParams aps;
+  // Beyond the paper: APS's window (+-1 m, +-3 m) assumes the prior is already that good. While it is
+  // not (the first GPS fix, after an outage), the window grows to this many prior sigmas, up to the
+  // maxima; a prior less certain than the maxima allow gets no intensity match at all.
+  double aps_window_sigmas = 3.0;
+  // Likewise for the curb matchers' correspondence distance: at least the configured one, widened to
+  // this many prior sigmas (up to the maximum) so that a first GPS fix 2-3 m off still converges.
+  double icp_window_sigmas = 3.0, icp_max_correspondence_m = 5.0;
+  double aps_max_lateral_range_m = 2.0, aps_max_longitudinal_range_m = 8.0;
   VehicleModelParams vehicle;
   PoseFilterParams filter;
   double process_position_without_can_per_s = 2.0;  // m per s of dead reckoning without CAN

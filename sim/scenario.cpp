@@ -228,7 +228,8 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
   }
   if (const YAML::Node p = root["pass"]) {
     y.expect_map(p, "pass");
-    y.allow_keys(p, {"lateral_rmse_m", "longitudinal_rmse_m", "heading_rmse_deg", "max_position_error_m"});
+    y.allow_keys(p, {"lateral_rmse_m", "longitudinal_rmse_m", "heading_rmse_deg", "max_position_error_m",
+                     "max_lane_offset_m", "settle_s"});
     auto opt = [&](const char* key, std::optional<double>& v) {
       if (p[key]) v = y.number_in(p[key], key, 0.0, 1e4);
     };
@@ -236,6 +237,8 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
     opt("longitudinal_rmse_m", s.pass.longitudinal_rmse_m);
     opt("heading_rmse_deg", s.pass.heading_rmse_deg);
     opt("max_position_error_m", s.pass.max_position_error_m);
+    opt("max_lane_offset_m", s.pass.max_lane_offset_m);
+    if (p["settle_s"]) s.pass.settle_s = y.number_in(p["settle_s"], "settle_s", 0.0, 60.0);
   }
   if (const YAML::Node o = root["output"]) {
     y.expect_map(o, "output");

@@ -61,6 +61,12 @@ struct EgoSpec {
 
 struct PassThresholds {
   std::optional<double> lateral_rmse_m, longitudinal_rmse_m, heading_rmse_deg, max_position_error_m;
+  // How far the car's true rear axle may stray from its lane's centre (closed loop: the controller
+  // steers on the estimate, so a localizer error becomes a driving error).
+  std::optional<double> max_lane_offset_m;
+  // Estimates in the first settle_s seconds (from the first estimate) are not scored: the localizer
+  // starts from one GPS fix that may be metres off, and its convergence is not its accuracy.
+  double settle_s = 0;
 };
 
 struct Scenario {

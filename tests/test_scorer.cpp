@@ -23,6 +23,13 @@ constexpr double kEps = 1e-12;
 constexpr int64_t kMs = 1'000'000;
 
 // A straight drive east at 10 m/s, 100 Hz, for `seconds`.
+// Every error threshold at `value` (lane keeping and settling unset).
+PassThresholds thresholds_at(double value) {
+  PassThresholds t;
+  t.lateral_rmse_m = t.longitudinal_rmse_m = t.heading_rmse_deg = t.max_position_error_m = value;
+  return t;
+}
+
 std::vector<TruthPose> straight_truth(double seconds) {
   std::vector<TruthPose> truth;
   for (int64_t t = 0; t <= int64_t(seconds * 1000) * kMs; t += 10 * kMs)
@@ -165,7 +172,7 @@ TEST(Score, NearestRankPercentiles) {
 TEST(Score, EachThresholdTripsOnItsOwn) {
   const auto truth = straight_truth(3);
   const auto est = offset_estimates(3, 0.3, 0.2, 0.01);  // 0.2 m lateral, 0.3 m long, 0.573 deg, 0.361 m
-  const PassThresholds loose{1.0, 1.0, 1.0, 1.0};
+  const PassThresholds loose = thresholds_at(1.0);
   EXPECT_TRUE(score(truth, est, loose, "m", "s").metrics.pass);
 
   auto trip = [&](PassThresholds t, const std::string& expected) {
@@ -208,7 +215,7 @@ TEST(Score, EstimatesOutsideTruthAreCountedNotScored) {
 TEST(Score, DivergedEstimateFails) {
   auto est = offset_estimates(1, 0, 0, 0);
   est[3].pose.x = std::nan("");
-  const Metrics m = score(straight_truth(1), est, PassThresholds{1.0, 1.0, 1.0, 1.0}, "m", "s").metrics;
+  const Metrics m = score(straight_truth(1), est, thresholds_at(1.0), "m", "s").metrics;
   EXPECT_FALSE(m.pass);
 }
 
@@ -376,6 +383,26 @@ TEST(ErrorPlots, WritePngsOfTheRequestedSize) {
   write_trajectory_plot(trajectory_png, {}, {}, {}, {}, {640, 480});
   EXPECT_EQ(cv::imread(trajectory_png).rows, 480);
   EXPECT_THROW(write_error_plot(errors_png, run.errors, {100, 100}), InputError);
+}
+
+TEST(Score, SettlingFramesAreNotScoredAndLaneKeepingIsChecked) {
+  const auto truth = straight_truth(3);
+  auto est = offset_estimates(3, 0.0, 0.0, 0.0);
+  est.front().pose.y += 5.0;  // the first fix, metres off
+  PassThresholds t;
+  t.max_position_error_m = 1.0;
+  EXPECT_FALSE(score(truth, est, t, "m", "s").metrics.pass);
+  t.settle_s = 1e-9 * double(est[1].stamp_ns - est[0].stamp_ns) / 2;  // only the first frame settles
+  ScoredRun run = score(truth, est, t, "m", "s");
+  EXPECT_TRUE(run.metrics.pass);
+  EXPECT_EQ(run.metrics.settling_frames, 1u);
+  t.max_lane_offset_m = 0.5;
+  run = score(truth, est, t, "m", "s");
+  score_lane_keeping(run.metrics, 0.4);
+  EXPECT_TRUE(run.metrics.pass);
+  score_lane_keeping(run.metrics, 0.6);
+  EXPECT_FALSE(run.metrics.pass);
+  EXPECT_EQ(run.metrics.max_lane_offset_m, 0.6);
 }
 
 }  // namespace

@@ -46,6 +46,10 @@ double max_lane_offset(const LoopResult& r, const Path& route) {
   return worst;
 }
 
+// A scan "has an obstacle in the corridor" with at least this many obstacle points (a pedestrian at
+// 30 m gives a few dozen; stray returns a handful).
+constexpr size_t kObstacleScanPoints = 20;
+
 struct Progress {
   bool terminal = isatty(STDOUT_FILENO) != 0;
   std::string what;
@@ -107,7 +111,9 @@ int run_run(const Args& args) {
   const MethodTrace& trace = r.methods.front();
   const std::vector<EstimateRecord> estimates = estimate_records(trace);
   const std::vector<TruthPose> truth = truth_poses(r);
-  const ScoredRun scored = score(truth, estimates, s.scenario.pass, trace.method, name);
+  ScoredRun scored = score(truth, estimates, s.scenario.pass, trace.method, name);
+  const double lane_offset = max_lane_offset(r, sim.resolved().ego_route);
+  score_lane_keeping(scored.metrics, lane_offset);
   write_metrics_json(out + "/metrics.json", scored.metrics);
   write_errors_csv(out + "/errors.csv", scored, estimates);
   write_tum(out + "/estimate.tum", estimates);
@@ -123,8 +129,11 @@ int run_run(const Args& args) {
               s.scenario.duration_s, r.wall_s, s.scenario.duration_s / r.wall_s, threads);
   std::printf("localizer  %zu scans, %.2f ms per scan on average, %.1f%% of the loop's time\n", r.scans,
               1e3 * r.localizer_wall_s / double(std::max<size_t>(r.scans, 1)), 100 * r.localizer_wall_s / r.wall_s);
-  std::printf("lane       the car stayed within %.2f m of its lane's centre\n",
-              max_lane_offset(r, sim.resolved().ego_route));
+  std::printf("lane       the car stayed within %.2f m of its lane's centre\n", lane_offset);
+  size_t with_obstacles = 0;
+  for (const auto& e : trace.estimates) with_obstacles += e.obstacle_points >= kObstacleScanPoints;
+  std::printf("obstacles  in the corridor in %zu of %zu scans (%.0f%%)\n", with_obstacles, trace.estimates.size(),
+              100.0 * double(with_obstacles) / double(std::max<size_t>(trace.estimates.size(), 1)));
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf("result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
               "trajectory.png, worst_frame.png)\n",

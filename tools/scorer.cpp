@@ -98,6 +98,10 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
       ++m.unscored_frames;
       continue;
     }
+    if (double(est.stamp_ns - estimates.front().stamp_ns) < thresholds.settle_s * 1e9) {
+      ++m.settling_frames;
+      continue;
+    }
     FrameError e = frame_error(truth_at(truth, est.stamp_ns), est.pose);
     e.stamp_ns = est.stamp_ns;
     lateral.push_back(e.lateral_m);
@@ -134,6 +138,12 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
   }
   m.pass = m.failures.empty();
   return run;
+}
+
+void score_lane_keeping(Metrics& m, double max_lane_offset_m) {
+  m.max_lane_offset_m = max_lane_offset_m;
+  check(m, "lane offset", max_lane_offset_m, m.thresholds.max_lane_offset_m, "m");
+  m.pass = m.failures.empty();
 }
 
 }  // namespace lidarloop

@@ -4,6 +4,7 @@
 // percentiles; pass / fail against a scenario's thresholds.
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -55,10 +56,12 @@ struct Metrics {
   std::string method, scenario;
   size_t frames = 0;            // estimates scored
   size_t unscored_frames = 0;   // estimates outside the truth's time range (not scored, reported)
+  size_t settling_frames = 0;   // estimates within thresholds.settle_s of the first (not scored)
   double lateral_rmse_m = 0, longitudinal_rmse_m = 0, heading_rmse_deg = 0, position_rmse_m = 0;
   double max_position_error_m = 0, max_lateral_m = 0, max_longitudinal_m = 0, max_heading_deg = 0;  // absolute
   int64_t worst_frame_stamp_ns = 0;  // the frame with the largest position error (for a bird's-eye plot)
   double latency_p50_ms = 0, latency_p99_ms = 0, latency_max_ms = 0;  // over every estimate
+  double max_lane_offset_m = std::numeric_limits<double>::quiet_NaN();  // set by score_lane_keeping
   PassThresholds thresholds;
   bool pass = false;
   std::vector<std::string> failures;  // for people, e.g. "lateral RMSE 0.310 m > 0.200 m"
@@ -73,6 +76,10 @@ struct ScoredRun {
 // Scores every estimate whose stamp lies within the truth's time range. Passes when there is at
 // least one scored frame and every threshold that is set holds (a non-finite value never holds).
 // Throws std::invalid_argument if the truth is not sorted by stamp.
+// The car's largest distance from its lane's centre (closed loop), checked against
+// thresholds.max_lane_offset_m; updates pass and failures.
+void score_lane_keeping(Metrics& metrics, double max_lane_offset_m);
+
 ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates,
                 const PassThresholds& thresholds, const std::string& method, const std::string& scenario);
 
