@@ -132,8 +132,7 @@ void Localizer::on_gps(const GpsFix& fix) {
   const Eigen::Vector2d p = frame_.to_local(fix.lat_deg, fix.lon_deg);
   const GpsNoise& n = params_.gps_noise;
   auto variance = [&](double reported, double floor) {
-    const double v = std::isfinite(reported) ? std::max(reported, floor * floor) : floor * floor;
-    return v * n.variance_scale;
+    return std::isfinite(reported) ? std::max(reported, floor * floor) : floor * floor;
   };
   const Eigen::Matrix3d R = Eigen::Vector3d(variance(fix.position_covariance[0], n.min_sigma_m),
                                             variance(fix.position_covariance[4], n.min_sigma_m),
@@ -141,10 +140,11 @@ void Localizer::on_gps(const GpsFix& fix) {
                                 .asDiagonal();
   last_gps_ns_ = fix.stamp_ns;
   if (!filter_) {
+    // One fix is as good as the receiver says; the scale is for the correlation between many.
     filter_.emplace(Pose2d{p.x(), p.y(), wrap_angle(fix.heading_rad)}, R, params_.filter);
     return;
   }
-  filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R);  // KF1
+  filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
 }
 
 uint32_t Localizer::input_health(int64_t t_ns) const {

@@ -58,9 +58,13 @@ struct HealthParams {
 struct GpsNoise {
   double min_sigma_m = 0.5;          // floor on the receiver's reported position sigma
   double min_heading_sigma_rad = 0.02;
-  // Scales the receiver's variances. A low-cost receiver's error is mostly a slowly wandering bias,
-  // so fixes 0.1 s apart are far from independent; 1 keeps the paper's plain KF1.
-  double variance_scale = 1.0;
+  // Scales the receiver's variances. A low-cost receiver's error is mostly a slowly wandering bias
+  // (Gauss-Markov, tau of minutes), so fixes 0.1 s apart are far from independent, and a filter that
+  // takes each as news is pulled to the bias within seconds wherever the map says little (between
+  // paint marks, beside a coach). 10 counts ten fixes as one. Measured on the scenario suite (seeds
+  // 5, 7, 8): dynamic_campus longitudinal RMSE 0.17-0.18 m against 0.19-0.26 m with 1, and
+  // bus_occlusion's worst error 0.24-0.28 m against 0.68 m.
+  double variance_scale = 10.0;
 };
 
 struct LocalizerParams {

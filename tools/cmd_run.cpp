@@ -1,4 +1,5 @@
 // lidarloop run / compare: a scenario with the localizer in the loop, scored against ground truth.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -152,6 +153,30 @@ std::vector<std::string> parse_methods(const std::string& list) {
   return out;
 }
 
+// The paper's claim as a check: `method` is at least as good as every other on each of the three
+// RMSEs. Exit 1 (and say where) when it is not.
+int expect_best(const std::vector<Metrics>& metrics, const std::string& method) {
+  const auto it = std::find_if(metrics.begin(), metrics.end(), [&](const Metrics& m) { return m.method == method; });
+  if (it == metrics.end()) throw InputError("--expect-best: method '" + method + "' is not among those compared");
+  bool best = true;
+  for (const Metrics& other : metrics) {
+    if (other.method == method) continue;
+    const std::pair<const char*, std::pair<double, double>> rows[] = {
+        {"lateral RMSE", {it->lateral_rmse_m, other.lateral_rmse_m}},
+        {"longitudinal RMSE", {it->longitudinal_rmse_m, other.longitudinal_rmse_m}},
+        {"heading RMSE", {it->heading_rmse_deg, other.heading_rmse_deg}}};
+    for (const auto& [what, values] : rows)
+      if (!(values.first <= values.second)) {
+        std::printf("NOT BEST   %s: %s %.3f > %s %.3f\n", what, method.c_str(), values.first, other.method.c_str(),
+                    values.second);
+        best = false;
+      }
+  }
+  std::printf("result     %s %s\n", method.c_str(), best ? "is at least as good as every other method on each RMSE"
+                                                         : "is not the best on every RMSE");
+  return best ? 0 : 1;
+}
+
 int run_compare(const Args& args) {
   const int threads = thread_count(args);
   const auto limit = limit_threads(threads);
@@ -200,6 +225,7 @@ int run_compare(const Args& args) {
   std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n", s.scenario.file.c_str(),
               (unsigned long long)s.scenario.seed, s.scenario.duration_s, r.scans, metrics.size());
   std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, truth.tum, <method>/...)\n", out.c_str());
+  if (const auto best = args.value("expect-best")) return expect_best(metrics, *best);
   return 0;
 }
 
@@ -221,10 +247,11 @@ Command run_command() {
 }
 
 Command compare_command() {
-  return {{"compare", "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--out DIR] [--seed N]",
+  return {{"compare", "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--expect-best NAME] [--out DIR] [--seed N]",
            "Simulate a scenario once and feed the identical streams to several localizer methods; print\n"
            "and write a table like the paper's Table III (comparison.md, comparison.csv).",
            {{"methods", "LIST", "all, or a comma-separated list of methods (default all)"},
+            {"expect-best", "NAME", "exit 1 unless this method has the lowest lateral, longitudinal and heading RMSE"},
             {"out", "DIR", "output folder (default out/<scenario name>-compare)"},
             {"seed", "N", "override the scenario's seed"},
             {"duration", "S", "override the scenario's duration, seconds"},

@@ -18,9 +18,9 @@ build() {  # build DIR [cmake options...]
 
 if [ "$what" = run ]; then
   build build -DLIDARLOOP_BUILD_TESTS=OFF
-  # Main job: the default scenario, a minute around the campus with traffic (no localizer yet).
-  build/tools/lidarloop simulate scenarios/campus_traffic.yaml --out build/out/campus_traffic
-  exit 0
+  # Main job: the default dynamic scenario with the localizer in the loop, scored against ground
+  # truth (exit 1 if it fails its thresholds).
+  exec build/tools/lidarloop run scenarios/dynamic_campus.yaml --out build/out/dynamic_campus
 fi
 
 build build
