@@ -154,14 +154,20 @@ uint32_t Localizer::input_health(int64_t t_ns) const {
   return flags;
 }
 
-bool Localizer::gate(double mahalanobis_sq, double threshold, int& rejections) const {
+bool Localizer::gate(double mahalanobis_sq, double threshold, int& rejections) {
   if (std::isfinite(mahalanobis_sq) && mahalanobis_sq <= threshold) {
     rejections = 0;
     return true;
   }
   if (++rejections > params_.health.max_rejections) {
-    rejections = 0;
-    return std::isfinite(mahalanobis_sq);
+    // The map keeps disagreeing: perhaps the filter, not the map, is wrong. It admits more doubt
+    // (its position variance doubles each further rejection, up to a cap), which opens the gate to
+    // an observation that stays consistent, while a matcher that has run off stays locked out.
+    const double cap = params_.health.max_inflated_sigma_m * params_.health.max_inflated_sigma_m;
+    const Eigen::Matrix3d& P = filter_->covariance();
+    Eigen::Matrix3d Q = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < 2; ++i) Q(i, i) = std::clamp(cap - P(i, i), 0.0, P(i, i));
+    filter_->inflate(Q);
   }
   return false;
 }
@@ -344,18 +350,15 @@ void Localizer::match_intensity(const std::vector<Eigen::Vector3d>& ground, cons
   to_vehicle << c, s, -s, c;
   const Eigen::Matrix2d spread = to_vehicle * filter_->covariance().topLeftCorner<2, 2>() * to_vehicle.transpose();
   ApsParams aps_params = params_.aps;
-  auto window = [&](double variance, double paper_range) {
-    const double wanted = params_.aps_window_sigmas * std::sqrt(std::max(variance, 0.0));
+  auto window = [&](double variance, double paper_range, double max_range) {
+    const double wanted = std::clamp(params_.aps_window_sigmas * std::sqrt(std::max(variance, 0.0)), paper_range,
+                                     std::max(paper_range, max_range));
     // Whole steps, so the window stays symmetric about the prior.
-    return std::ceil(std::max(paper_range, wanted) / aps_params.step_m) * aps_params.step_m;
+    return std::floor(wanted / aps_params.step_m + 1e-9) * aps_params.step_m;
   };
-  aps_params.longitudinal_range_m = window(spread(0, 0), params_.aps.longitudinal_range_m);
-  aps_params.lateral_range_m = window(spread(1, 1), params_.aps.lateral_range_m);
-  if (aps_params.longitudinal_range_m > params_.aps_max_longitudinal_range_m + 1e-9 ||
-      aps_params.lateral_range_m > params_.aps_max_lateral_range_m + 1e-9) {
-    e.health |= kIntensityMatchRejected;  // the prior is too vague for a local search
-    return;
-  }
+  aps_params.longitudinal_range_m =
+      window(spread(0, 0), params_.aps.longitudinal_range_m, params_.aps_max_longitudinal_range_m);
+  aps_params.lateral_range_m = window(spread(1, 1), params_.aps.lateral_range_m, params_.aps_max_lateral_range_m);
   const IntensityGrid S = build_intensity_grid(ground, intensities, prior, params_.intensity_grid);  // Eq. 8
   const ApsResult aps = aps_match(S, map_.intensity, aps_params);  // Eq. 14-18
   e.intensity_cells = aps.cells_used;
@@ -370,12 +373,13 @@ void Localizer::match_intensity(const std::vector<Eigen::Vector3d>& ground, cons
   }
   e.intensity_observation = aps.position;
   const Eigen::Vector2d innovation = aps.position - xy(prior);
-  const Eigen::Matrix2d S2 = filter_->covariance().topLeftCorner<2, 2>() + aps.covariance;
+  const Eigen::Matrix2d R = aps.covariance * params_.aps_covariance_scale;
+  const Eigen::Matrix2d S2 = filter_->covariance().topLeftCorner<2, 2>() + R;
   if (!gate(innovation.dot(S2.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
     e.health |= kIntensityMatchRejected;
     return;
   }
-  filter_->update_intensity(aps.position, aps.covariance);  // KF2
+  filter_->update_intensity(aps.position, R);  // KF2
   e.stage_ms[size_t(Stage::fusion)] += watch.lap_ms();
 }
 

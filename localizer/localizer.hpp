@@ -100,8 +100,9 @@ class Localizer {
   void match_curbs(const std::vector<Eigen::Vector2d>& features, LocalizerEstimate& e);
   void match_intensity(const std::vector<Eigen::Vector3d>& ground, const std::vector<double>& intensities,
                        LocalizerEstimate& e);
-  // The chi^2 gate with its escape after max_rejections in a row; true: use the observation.
-  bool gate(double mahalanobis_sq, double threshold, int& rejections) const;
+  // The chi^2 gate, with the filter's doubt growing after max_rejections in a row (see
+  // HealthParams); true: use the observation.
+  bool gate(double mahalanobis_sq, double threshold, int& rejections);
 
   HdMap& map_;
   LocalizerParams params_;

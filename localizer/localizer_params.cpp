@@ -93,6 +93,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   top.number("process_position_without_can_per_s", p.process_position_without_can_per_s, 0.0, 100.0);
   top.number("aps_window_sigmas", p.aps_window_sigmas, 0.0, 100.0);
   top.number("icp_window_sigmas", p.icp_window_sigmas, 0.0, 100.0);
+  top.number("aps_covariance_scale", p.aps_covariance_scale, 1e-3, 1e3);
   top.number("icp_max_correspondence_m", p.icp_max_correspondence_m, 0.1, 100.0);
   top.number("aps_max_lateral_range_m", p.aps_max_lateral_range_m, 0.0, 50.0);
   top.number("aps_max_longitudinal_range_m", p.aps_max_longitudinal_range_m, 0.0, 50.0);
@@ -231,6 +232,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("gate_curb", p.health.gate_curb, 0.0, 1e9)
       .number("gate_intensity", p.health.gate_intensity, 0.0, 1e9)
       .integer("max_rejections", p.health.max_rejections, 0, 1000000)
+      .number("max_inflated_sigma_m", p.health.max_inflated_sigma_m, 0.0, 1000.0)
       .done();
   top.done();
 }

@@ -49,10 +49,12 @@ struct HealthParams {
   int min_curbs = 15;          // fewer curb features (n_p): no curb observation
   double min_inlier_ratio = 0.5;  // a match explaining fewer of the features is not used
   // Innovation gate of the map-matching observations: chi^2 with 3 (curbs) or 2 (intensity) degrees of
-  // freedom at 99.9 %. Past `max_rejections` in a row the observation is taken anyway: the filter, not
-  // the map, is then the likelier to be wrong, and refusing forever would never let it recover.
+  // freedom at 99.9 %. Past `max_rejections` in a row the filter doubles its position variance with
+  // every further rejection, up to max_inflated_sigma_m: if the filter is what went wrong, the gate
+  // then opens to the map; a matcher that has run off (tens of metres) stays locked out.
   double gate_curb = 16.27, gate_intensity = 13.82;
   int max_rejections = 10;
+  double max_inflated_sigma_m = 2.0;
 };
 
 struct GpsNoise {
@@ -89,12 +91,14 @@ struct LocalizerParams {
   ApsParams aps;
   // Beyond the paper: APS's window (+-1 m, +-3 m) assumes the prior is already that good. While it is
   // not (the first GPS fix, after an outage), the window grows to this many prior sigmas, up to the
-  // maxima; a prior less certain than the maxima allow gets no intensity match at all.
+  // maxima (a peak on the window's edge is then refused: the truth may lie beyond).
   double aps_window_sigmas = 3.0;
   // Likewise for the curb matchers' correspondence distance: at least the configured one, widened to
   // this many prior sigmas (up to the maximum) so that a first GPS fix 2-3 m off still converges.
   double icp_window_sigmas = 3.0, icp_max_correspondence_m = 5.0;
   double aps_max_lateral_range_m = 2.0, aps_max_longitudinal_range_m = 8.0;
+  // APS's covariance (the spread of Eq. 14's distribution) times this is the observation noise.
+  double aps_covariance_scale = 1.0;
   VehicleModelParams vehicle;
   PoseFilterParams filter;
   double process_position_without_can_per_s = 2.0;  // m per s of dead reckoning without CAN
