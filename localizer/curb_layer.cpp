@@ -65,18 +65,24 @@ CurbLayer& CurbLayer::operator=(CurbLayer&& other) noexcept {
   return *this;
 }
 
-std::vector<Eigen::Vector2d> CurbLayer::window(const Eigen::Vector2d& centre, double half_extent) const {
+std::vector<size_t> CurbLayer::window_indices(const Eigen::Vector2d& centre, double half_extent) const {
   std::vector<std::pair<uint32_t, double>> matches;
   nanoflann::SearchParams params;
   params.sorted = false;
   const double radius = half_extent * std::sqrt(2.0);
   index_->tree.radiusSearch(centre.data(), radius * radius, matches, params);
   std::sort(matches.begin(), matches.end());  // deterministic order: by point index
-  std::vector<Eigen::Vector2d> out;
+  std::vector<size_t> out;
   for (const auto& [i, d2] : matches) {
     const Eigen::Vector2d& p = points_[i];
-    if (std::abs(p.x() - centre.x()) <= half_extent && std::abs(p.y() - centre.y()) <= half_extent) out.push_back(p);
+    if (std::abs(p.x() - centre.x()) <= half_extent && std::abs(p.y() - centre.y()) <= half_extent) out.push_back(i);
   }
+  return out;
+}
+
+std::vector<Eigen::Vector2d> CurbLayer::window(const Eigen::Vector2d& centre, double half_extent) const {
+  std::vector<Eigen::Vector2d> out;
+  for (size_t i : window_indices(centre, half_extent)) out.push_back(points_[i]);
   return out;
 }
 

@@ -30,6 +30,8 @@ class CurbLayer {
 
   // Curb points inside the axis-aligned square of half size `half_extent` around `centre`.
   std::vector<Eigen::Vector2d> window(const Eigen::Vector2d& centre, double half_extent) const;
+  // The same window as indices into points() and tangents(), in increasing order.
+  std::vector<size_t> window_indices(const Eigen::Vector2d& centre, double half_extent) const;
   // Distance from p to the nearest curb point (at most spacing/2 more than to the curb line).
   double distance(const Eigen::Vector2d& p) const;
 

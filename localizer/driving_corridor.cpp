@@ -56,30 +56,31 @@ DrivingCorridor extract_driving_corridor(const std::vector<Eigen::Vector2d>& cur
     cv::dilate(grid, grid, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
   }
 
-  // Label the free space. 4-connectivity: free space must not slip diagonally between two occupied
-  // cells that touch only at a corner, which is exactly how a diagonal curb line is rasterised.
+  // The connected free region around the vehicle. Only that one component is wanted, so a flood fill
+  // from the vehicle's cell does the work of labelling every component (and costs a third as much).
+  // 4-connectivity: free space must not slip diagonally between two occupied cells that touch only
+  // at a corner, which is exactly how a diagonal curb line is rasterised.
   cv::Mat free_space = grid == 0;  // 255 where free
-  cv::Mat labels;
-  cv::connectedComponents(free_space, labels, 4, CV_32S);
-
   const cv::Point centre(params.width_cells / 2, params.height_cells / 2);
-  int label = labels.at<int>(centre);
-  if (label == 0) {
+  cv::Point seed = centre;
+  if (free_space.at<std::uint8_t>(centre) == 0) {
     // The vehicle's cell is a curb (or within the dilation radius of one): the pose is slightly off,
-    // or the car really is next to the curb. Take the component of the nearest free cell; a full scan
-    // is cheap next to the dilation and happens rarely.
+    // or the car really is next to the curb. Start from the nearest free cell; a full scan is cheap
+    // next to the dilation and happens rarely.
     long best = std::numeric_limits<long>::max();
-    for (int r = 0; r < labels.rows; ++r) {
-      const int* row = labels.ptr<int>(r);
-      for (int c = 0; c < labels.cols; ++c) {
+    for (int r = 0; r < free_space.rows; ++r) {
+      const std::uint8_t* row = free_space.ptr<std::uint8_t>(r);
+      for (int c = 0; c < free_space.cols; ++c) {
         if (row[c] == 0) continue;
         const long d2 = static_cast<long>(r - centre.y) * (r - centre.y) + static_cast<long>(c - centre.x) * (c - centre.x);
-        if (d2 < best) best = d2, label = row[c];
+        if (d2 < best) best = d2, seed = {c, r};
       }
     }
-    if (label == 0) return out;  // everything is occupied: no corridor
+    if (best == std::numeric_limits<long>::max()) return out;  // everything is occupied: no corridor
   }
-  out.mask = labels == label;  // CV_8U, 255 inside
+  constexpr std::uint8_t kCorridor = 128;  // neither free (255) nor occupied (0)
+  cv::floodFill(free_space, seed, cv::Scalar(kCorridor), nullptr, cv::Scalar(0), cv::Scalar(0), 4);
+  out.mask = free_space == kCorridor;  // CV_8U, 255 inside
   return out;
 }
 

@@ -77,7 +77,6 @@ Localizer::Localizer(HdMap& map, const LocalizerParams& params)
     : map_(map),
       params_(params),
       frame_(map.curbs.map().origin),
-      map_index_(map.curbs.points()),
       rng_(params.seed),
       predictor_(params.vehicle),
       accumulator_(params.curb_features.frames) {}
@@ -289,26 +288,34 @@ void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, Locali
         std::max(p.max_correspondence, std::min(params_.icp_window_sigmas * sigma, params_.icp_max_correspondence_m));
     return p;
   };
+  // The map's curbs around the prior in a small KD-tree of their own: the matchers' thousands of
+  // nearest-neighbour queries are then cheaper than in the whole map's tree.
+  std::vector<Eigen::Vector2d> local_points, local_tangents;
+  for (size_t i : map_.curbs.window_indices(xy(prior), params_.map_window_m)) {
+    local_points.push_back(map_.curbs.points()[i]);
+    local_tangents.push_back(map_.curbs.tangents()[i]);
+  }
+  const MapIndex local_map(local_points);
   Transform2d t;
   switch (params_.method) {
     case LocalizerMethod::proposed: {
       ProbabilisticIcpParams p = params_.probabilistic_icp;
       p.local = widened(p.local);  // the global ICP keeps d_g
-      t = probabilistic_icp(map_index_, world, {}, p, rng_).t;
+      t = probabilistic_icp(local_map, world, {}, p, rng_).t;
       break;
     }
     case LocalizerMethod::icp:
     case LocalizerMethod::icp_obs:
-      t = icp(map_index_, world, {}, widened(params_.icp)).t;
+      t = icp(local_map, world, {}, widened(params_.icp)).t;
       break;
     case LocalizerMethod::m_icp: {
       MIcpParams p = params_.m_icp;
       p.icp = widened(p.icp);
-      t = m_icp(map_index_, world, {}, p).t;
+      t = m_icp(local_map, world, {}, p).t;
       break;
     }
     case LocalizerMethod::fmt: {
-      const FmtResult f = fmt_match(world, map_.curbs.window(xy(prior), params_.map_window_m), xy(prior), params_.fmt);
+      const FmtResult f = fmt_match(world, local_points, xy(prior), params_.fmt);
       if (!f.ok) {
         e.stage_ms[size_t(Stage::curb_matching)] += watch.lap_ms();
         e.health |= kCurbMatchRejected;
@@ -322,7 +329,7 @@ void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, Locali
   }
   const Eigen::Vector2d corrected_xy = t.apply(xy(prior));
   const Pose2d z{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t.theta)};
-  const CurbMatchQuality q = curb_match_quality(features, z, map_index_, map_.curbs.tangents(), params_.curb_noise);
+  const CurbMatchQuality q = curb_match_quality(features, z, local_map, local_tangents, params_.curb_noise);
   e.curb_observation = z;
   e.curb_inlier_ratio = q.inlier_ratio;
   e.stage_ms[size_t(Stage::curb_matching)] += watch.lap_ms();

@@ -107,7 +107,6 @@ class Localizer {
   HdMap& map_;
   LocalizerParams params_;
   LocalFrame frame_;
-  MapIndex map_index_;
   std::mt19937_64 rng_;
 
   MotionPredictor predictor_;
