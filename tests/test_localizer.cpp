@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <random>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "localizer/localizer.hpp"
@@ -38,7 +40,9 @@ HdMap synthetic_map() {
   std::normal_distribution<double> noise(0, 2.0);
   for (double x = -100; x < 700; x += 0.1)
     for (double y = -kCurbY; y <= kCurbY; y += 0.1) builder.add({x, y}, reflectivity(x, y) + noise(rng));
-  const std::string dir = (std::filesystem::temp_directory_path() / "lidarloop_test_localizer_map").string();
+  // One folder per process: CTest runs the test cases as parallel processes.
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("lidarloop_test_localizer_map_" + std::to_string(getpid()))).string();
   builder.save(dir);
   return HdMap{CurbLayer(curbs), IntensityMap(dir)};
 }

@@ -8,13 +8,16 @@ packages=(
   libembree-dev libeigen3-dev libgeographiclib-dev libnanoflann-dev libyaml-cpp-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libpolyclipping-dev nlohmann-json3-dev
+  libpolyclipping-dev nlohmann-json3-dev libzstd-dev
 )
 
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# The MCAP cross-check test (label `node`) runs Node.js; a node already on PATH (e.g. from
+# NodeSource) is kept, Debian's nodejs and npm are installed only when there is none.
+command -v node >/dev/null 2>&1 || missing+=(nodejs npm)
 [ ${#missing[@]} -eq 0 ] && exit 0
 
 if [ "$(id -u)" -eq 0 ]; then sudo_cmd=(); else sudo_cmd=(sudo); fi

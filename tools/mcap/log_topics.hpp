@@ -1,0 +1,45 @@
+#pragma once
+// The topics of a lidarloop log (MCAP, ROS 2 profile), their message types and frames: the contract
+// between the recorder and whatever reads a log back (replay, export, info, other people's tools).
+//
+//   topic                 type                              frame_id -> child
+//   /lidar/points         sensor_msgs/msg/PointCloud2       lidar (layout in ros2_messages.hpp)
+//   /gps/fix              sensor_msgs/msg/NavSatFix         gps   (low-cost receiver)
+//   /gps/heading          lidarloop_msgs/msg/GnssHeading    gps
+//   /gps/rtk/fix          sensor_msgs/msg/NavSatFix         gps   (RTK-grade reference)
+//   /gps/rtk/heading      lidarloop_msgs/msg/GnssHeading    gps
+//   /vehicle/report       lidarloop_msgs/msg/VehicleReport  base_link (CAN wheel speeds, steering)
+//   /truth/odometry       nav_msgs/msg/Odometry             map -> base_link (speed, yaw rate as twist)
+//   /truth/state          lidarloop_msgs/msg/TruthState     map (lossless: replay scores against it)
+//   /truth/actors         lidarloop_msgs/msg/ActorArray     map
+//   /localizer/odometry   nav_msgs/msg/Odometry             map -> base_link_estimate (with covariance)
+//   /tf                   tf2_msgs/msg/TFMessage            map -> base_link (truth), map -> base_link_estimate
+//   /tf_static            tf2_msgs/msg/TFMessage            base_link -> lidar (mount), base_link -> gps
+//
+// Frames: map is the local transverse Mercator frame (x east, y north, z up); base_link is the
+// vehicle frame (x forward, y left, z up, origin at the rear axle centre on the ground); the GPS
+// antenna model sits at the base_link origin. Header stamps are measurement times; a message's MCAP
+// log_time is when the recorder received it in simulation time (never earlier than the log time of
+// the message before it), so replaying in log-time order gives exactly the order of the live run.
+namespace lidarloop::log_topics {
+
+inline constexpr const char* scan = "/lidar/points";
+inline constexpr const char* gps_fix = "/gps/fix";
+inline constexpr const char* gps_heading = "/gps/heading";
+inline constexpr const char* rtk_fix = "/gps/rtk/fix";
+inline constexpr const char* rtk_heading = "/gps/rtk/heading";
+inline constexpr const char* vehicle_report = "/vehicle/report";
+inline constexpr const char* truth_odometry = "/truth/odometry";
+inline constexpr const char* truth_state = "/truth/state";
+inline constexpr const char* truth_actors = "/truth/actors";
+inline constexpr const char* estimate = "/localizer/odometry";
+inline constexpr const char* tf = "/tf";
+inline constexpr const char* tf_static = "/tf_static";
+
+inline constexpr const char* map_frame = "map";
+inline constexpr const char* vehicle_frame = "base_link";
+inline constexpr const char* estimate_frame = "base_link_estimate";
+inline constexpr const char* lidar_frame = "lidar";
+inline constexpr const char* gps_frame = "gps";
+
+}  // namespace lidarloop::log_topics
