@@ -2,6 +2,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <iostream>
 #include <sstream>
 #include <unistd.h>
@@ -13,39 +15,12 @@
 #include "tools/localizer_loop.hpp"
 #include "tools/localizer_setup.hpp"
 #include "tools/result_files.hpp"
+#include "tools/run_outputs.hpp"
+#include "tools/run_recording.hpp"
 #include "tools/scene_setup.hpp"
 
 namespace lidarloop {
 namespace {
-
-std::vector<TruthPose> truth_poses(const LoopResult& r) {
-  std::vector<TruthPose> out;
-  out.reserve(r.truth.size());
-  for (const auto& t : r.truth) out.push_back({t.stamp_ns, t.pose});
-  return out;
-}
-
-std::vector<EstimateRecord> estimate_records(const MethodTrace& trace) {
-  std::vector<EstimateRecord> out;
-  out.reserve(trace.estimates.size());
-  for (const auto& e : trace.estimates)
-    if (!(e.health & kNotInitialized)) out.push_back({e.stamp_ns, e.pose, e.covariance, describe_health(e.health), e.total_ms});
-  return out;
-}
-
-// The true pose's distance from the lane centre the ego was told to follow (closed loop: how far a
-// localizer's error pushed the car).
-double max_lane_offset(const LoopResult& r, const Path& route) {
-  double worst = 0, s = 0;
-  constexpr double kSearch = 30.0;  // m along the route around the previous projection
-  for (size_t i = 0; i < r.truth.size(); ++i) {
-    const Eigen::Vector2d p(r.truth[i].pose.x, r.truth[i].pose.y);
-    s = i == 0 ? route.project(p) : route.project(p, std::max(0.0, s - kSearch), std::min(route.length, s + kSearch));
-    const Pose2d on = route.pose_at(s);
-    worst = std::max(worst, std::abs(-std::sin(on.yaw) * (p.x() - on.x) + std::cos(on.yaw) * (p.y() - on.y)));
-  }
-  return worst;
-}
 
 // A scan "has an obstacle in the corridor" with at least this many obstacle points (a pedestrian at
 // 30 m gives a few dozen; stray returns a handful).
@@ -64,26 +39,6 @@ struct Progress {
     if (terminal) std::printf("\r%70s\r", "");
   }
 };
-
-void write_worst_frame(const std::string& path, const WorstFrame& w, const HdMap& map, const std::string& method) {
-  if (w.error_m < 0) return;
-  auto place = [&](const std::vector<Eigen::Vector2d>& vehicle_points) {
-    std::vector<Eigen::Vector2d> world;
-    const double c = std::cos(w.estimate.yaw), s = std::sin(w.estimate.yaw);
-    for (const auto& p : vehicle_points)
-      world.emplace_back(w.estimate.x + c * p.x() - s * p.y(), w.estimate.y + s * p.x() + c * p.y());
-    return world;
-  };
-  BirdseyeOptions o;
-  std::ostringstream title;
-  title.precision(2);
-  title << std::fixed << method << ": worst frame, position error " << w.error_m << " m";
-  o.title = title.str();
-  o.marks = {{"curb features (placed at the estimate)", place(w.features.curbs), {0, 0, 255}},
-             {"obstacle points (placed at the estimate)", place(w.features.obstacles), {255, 0, 255}}};
-  o.poses = {{"ground truth", w.truth, {255, 255, 255}}, {"estimate", w.estimate, {0, 200, 255}}};
-  write_birdseye_png(path, w.cloud, w.sensor_pose, map.curbs.map().curbs, o);
-}
 
 void print_metrics_table(const std::vector<Metrics>& metrics) { std::cout << comparison_markdown(metrics); }
 
@@ -106,24 +61,22 @@ int run_run(const Args& args) {
   HdMap map = open_scenario_map(s.scenario);
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_name(params.method), s.scenario.duration_s};
-  const LoopResult r = run_localizer_loop(sim, map, {params}, s.scenario.closed_loop, nullptr, std::ref(progress));
+  const std::unique_ptr<McapRecorder> recorder =
+      start_recording(args.value("record"), s.scenario, method_name(params.method));
+  std::function<void(const LocalizerEstimate&)> record_estimate;
+  if (recorder)
+    record_estimate = [&](const LocalizerEstimate& e) {
+      if (!(e.health & kNotInitialized)) recorder->write_estimate(e.stamp_ns, e.pose, e.covariance);
+    };
+  const LoopResult r = run_localizer_loop(sim, map, {params}, s.scenario.closed_loop, recorder.get(),
+                                          std::ref(progress), record_estimate);
+  if (recorder) recorder->close();
   progress.clear();
 
   const MethodTrace& trace = r.methods.front();
-  const std::vector<EstimateRecord> estimates = estimate_records(trace);
-  const std::vector<TruthPose> truth = truth_poses(r);
-  ScoredRun scored = score(truth, estimates, s.scenario.pass, trace.method, name);
-  const double lane_offset = max_lane_offset(r, sim.resolved().ego_route);
-  score_lane_keeping(scored.metrics, lane_offset);
-  write_metrics_json(out + "/metrics.json", scored.metrics);
-  write_errors_csv(out + "/errors.csv", scored, estimates);
-  write_tum(out + "/estimate.tum", estimates);
-  write_tum(out + "/truth.tum", truth);
-  write_junit(out + "/junit.xml", {scored.metrics});
-  write_error_plot(out + "/errors.png", scored.errors);
-  write_trajectory_plot(out + "/trajectory.png", truth, estimates, scored.errors, map.curbs.map().curbs);
-  write_worst_frame(out + "/worst_frame.png", trace.worst, map, trace.method);
-
+  const ScoredRun scored = score_and_write(out, name, s.scenario, sim.resolved().ego_route, r.truth, trace.method,
+                                           trace.estimates, &trace.worst, map);
+  const double lane_offset = scored.metrics.max_lane_offset_m;
   print_metrics_table({scored.metrics});
   std::printf("\nscenario   %s (seed %llu, %s loop), %.1f s simulated in %.1f s wall (%.1fx real time, %d thread(s))\n",
               s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.closed_loop ? "closed" : "open",
@@ -197,21 +150,11 @@ int run_compare(const Args& args) {
   const LoopResult r = run_localizer_loop(sim, map, params, false, nullptr, std::ref(progress));
   progress.clear();
 
-  const std::vector<TruthPose> truth = truth_poses(r);
   std::vector<Metrics> metrics;
-  for (const auto& trace : r.methods) {
-    const std::vector<EstimateRecord> estimates = estimate_records(trace);
-    const ScoredRun scored = score(truth, estimates, s.scenario.pass, trace.method, name);
-    const std::string dir = out + "/" + trace.method;
-    std::filesystem::create_directories(dir);
-    write_metrics_json(dir + "/metrics.json", scored.metrics);
-    write_errors_csv(dir + "/errors.csv", scored, estimates);
-    write_tum(dir + "/estimate.tum", estimates);
-    write_error_plot(dir + "/errors.png", scored.errors);
-    write_worst_frame(dir + "/worst_frame.png", trace.worst, map, trace.method);
-    metrics.push_back(scored.metrics);
-  }
-  write_tum(out + "/truth.tum", truth);
+  for (const auto& trace : r.methods)
+    metrics.push_back(score_and_write(out + "/" + trace.method, name, s.scenario, sim.resolved().ego_route, r.truth,
+                                      trace.method, trace.estimates, &trace.worst, map)
+                          .metrics);
   write_junit(out + "/junit.xml", metrics);
   write_comparison_csv(out + "/comparison.csv", metrics);
   const std::string table = comparison_markdown(metrics);
@@ -224,7 +167,7 @@ int run_compare(const Args& args) {
   std::cout << table;
   std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n", s.scenario.file.c_str(),
               (unsigned long long)s.scenario.seed, s.scenario.duration_s, r.scans, metrics.size());
-  std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, truth.tum, <method>/...)\n", out.c_str());
+  std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, <method>/...)\n", out.c_str());
   if (const auto best = args.value("expect-best")) return expect_best(metrics, *best);
   return 0;
 }
@@ -232,7 +175,8 @@ int run_compare(const Args& args) {
 }  // namespace
 
 Command run_command() {
-  return {{"run", "lidarloop run SCENARIO.yaml [--method NAME] [--loop open|closed] [--out DIR] [--seed N]",
+  return {{"run", "lidarloop run SCENARIO.yaml [--method NAME] [--loop open|closed] [--out DIR] [--seed N]\n"
+                  "                    [--record FILE.mcap]",
            "Run a scenario with the localizer in the loop and score it against ground truth. Writes\n"
            "metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and plots to DIR. Exit 0 when\n"
            "every threshold of the scenario's `pass` holds, 1 when one fails, 2 on bad input.",
@@ -241,6 +185,7 @@ Command run_command() {
             {"out", "DIR", "output folder (default out/<scenario name>)"},
             {"seed", "N", "override the scenario's seed"},
             {"duration", "S", "override the scenario's duration, seconds"},
+            {"record", "FILE.mcap", "record every stream and the estimates as an MCAP log (replay redoes the run)"},
             {"threads", "N", "worker threads (default: all cores)"}},
            1, 1},
           run_run};

@@ -3,11 +3,13 @@
 #include <filesystem>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <unistd.h>
 
 #include "tools/commands.hpp"
 #include "tools/csv_streams.hpp"
 #include "tools/localizer_setup.hpp"
+#include "tools/run_recording.hpp"
 #include "tools/scene_setup.hpp"
 #include "tools/world_map_png.hpp"
 
@@ -36,14 +38,17 @@ int run_simulate(const Args& args) {
 
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   CsvStreams streams(out, LocalFrame(s.world.description.origin), scan_every);
+  const std::unique_ptr<McapRecorder> recorder = start_recording(args.value("record"), s.scenario, "");
+  TeeSink sink(streams, recorder.get());
   const bool terminal = isatty(STDOUT_FILENO);
   const auto t0 = std::chrono::steady_clock::now();
-  sim.run(streams, [&](double fraction) {
+  sim.run(sink, [&](double fraction) {
     if (!terminal) return;
     std::printf("\rsimulate %3d%%  %.1f of %.1f s", int(fraction * 100), fraction * s.scenario.duration_s,
                 s.scenario.duration_s);
     std::fflush(stdout);
   });
+  if (recorder) recorder->close();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (terminal) std::printf("\r%60s\r", "");
 
@@ -71,13 +76,15 @@ Command validate_command() {
 }
 
 Command simulate_command() {
-  return {{"simulate", "lidarloop simulate SCENARIO.yaml [--out DIR] [--seed N] [--duration S] [--scan-every N]",
+  return {{"simulate", "lidarloop simulate SCENARIO.yaml [--out DIR] [--seed N] [--duration S] [--scan-every N]\n"
+           "                         [--record FILE.mcap]",
            "Run a scenario's world, ego, traffic and sensors without a localizer; write the streams as CSV,\n"
            "every Nth scan as PLY, and a top view of roads, actors and the ego's path.",
            {{"out", "DIR", "output folder (default out/<scenario name>)"},
             {"seed", "N", "override the scenario's seed"},
             {"duration", "S", "override the scenario's duration, seconds"},
             {"scan-every", "N", "write every Nth scan as PLY (0: none; default from the scenario, 10)"},
+            {"record", "FILE.mcap", "also record every stream as an MCAP log"},
             {"threads", "N", "worker threads (default: all cores)"}},
            1, 1},
           run_simulate};

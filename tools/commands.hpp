@@ -22,6 +22,7 @@ Command recover_command();
 Command export_command();
 Command run_command();
 Command compare_command();
+Command replay_command();
 int run_bench_map(const Args& args);
 int run_bench_localizer(const Args& args);
 int run_bench_loop(const Args& args);

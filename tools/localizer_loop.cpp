@@ -10,8 +10,9 @@ using Clock = std::chrono::steady_clock;
 
 class LoopSink : public StreamSink {
  public:
-  LoopSink(HdMap& map, const std::vector<LocalizerParams>& methods, StreamSink* also, LoopResult& result)
-      : also_(also), result_(result) {
+  LoopSink(HdMap& map, const std::vector<LocalizerParams>& methods, StreamSink* also,
+           const std::function<void(const LocalizerEstimate&)>& on_estimate, LoopResult& result)
+      : also_(also), on_estimate_(on_estimate), result_(result) {
     for (const auto& p : methods) {
       localizers_.push_back(std::make_unique<Localizer>(map, p));
       result_.methods.push_back({method_name(p.method), {}, {}});
@@ -56,6 +57,7 @@ class LoopSink : public StreamSink {
           trace.worst = {error, cloud, sensor_pose, localizers_[i]->last_features(), truth, e.pose};
         }
       }
+      if (i == 0 && on_estimate_) on_estimate_(e);
       trace.estimates.push_back(std::move(e));
     }
   }
@@ -74,16 +76,18 @@ class LoopSink : public StreamSink {
 
   std::vector<std::unique_ptr<Localizer>> localizers_;
   StreamSink* also_;
+  std::function<void(const LocalizerEstimate&)> on_estimate_;
   LoopResult& result_;
 };
 
 }  // namespace
 
 LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<LocalizerParams>& methods,
-                              bool closed_loop, StreamSink* also, const std::function<void(double)>& progress) {
+                              bool closed_loop, StreamSink* also, const std::function<void(double)>& progress,
+                              const std::function<void(const LocalizerEstimate&)>& on_estimate) {
   LoopResult result;
   if (methods.empty()) return result;
-  LoopSink sink(map, methods, also, result);
+  LoopSink sink(map, methods, also, on_estimate, result);
   if (closed_loop) {
     sim.set_pose_source([&sink](int64_t, const Pose2d& truth) { return sink.primary().pose().value_or(truth); });
   }

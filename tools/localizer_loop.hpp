@@ -41,8 +41,10 @@ struct LoopResult {
 // Runs `sim` to its end. `also`: another sink that sees every stream too (a recorder), or null.
 // `progress` is called with the fraction done. Closed loop: the controller steers on the first
 // method's pose (its filter, predicted to the latest CAN frame) once that is initialised.
+// `on_estimate` sees the first method's every estimate as it is made (a recorder).
 LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<LocalizerParams>& methods,
                               bool closed_loop, StreamSink* also = nullptr,
-                              const std::function<void(double)>& progress = {});
+                              const std::function<void(double)>& progress = {},
+                              const std::function<void(const LocalizerEstimate&)>& on_estimate = {});
 
 }  // namespace lidarloop

@@ -14,6 +14,8 @@ namespace lidarloop {
 class CdrWriter {
  public:
   CdrWriter();
+  // Writes into `reuse` (emptied first), so a caller encoding big messages keeps one allocation.
+  explicit CdrWriter(std::vector<uint8_t>&& reuse);
 
   void u8(uint8_t v) { put(v, 1); }
   void i8(int8_t v) { put(uint8_t(v), 1); }

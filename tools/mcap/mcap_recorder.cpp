@@ -86,7 +86,8 @@ void McapRecorder::on_rtk(const GpsFix& fix) {
 void McapRecorder::on_scan(const PointCloud& cloud, const Eigen::Isometry3d&) {
   // The sensor pose is not logged separately: /tf (truth) and /tf_static (mount) give it.
   static constexpr ChannelSpec points{t::scan, "sensor_msgs/msg/PointCloud2"};
-  write(points, cloud.stamp_ns, ros2::encode_point_cloud(cloud, t::lidar_frame));
+  ros2::encode_point_cloud(cloud, t::lidar_frame, scan_buffer_);
+  write(points, cloud.stamp_ns, scan_buffer_);
 }
 
 void McapRecorder::on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) {

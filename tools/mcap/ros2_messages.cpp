@@ -122,6 +122,12 @@ Stamp to_stamp(int64_t ns) {
 int64_t from_stamp(Stamp s) { return int64_t(s.sec) * kNsPerSec + int64_t(s.nanosec); }
 
 Bytes encode_point_cloud(const PointCloud& cloud, const std::string& frame_id) {
+  Bytes out;
+  encode_point_cloud(cloud, frame_id, out);
+  return out;
+}
+
+void encode_point_cloud(const PointCloud& cloud, const std::string& frame_id, Bytes& out) {
   static constexpr struct {
     const char* name;
     uint32_t offset;
@@ -129,7 +135,7 @@ Bytes encode_point_cloud(const PointCloud& cloud, const std::string& frame_id) {
   } fields[] = {{"x", 0, FLOAT32},         {"y", 4, FLOAT32},   {"z", 8, FLOAT32},
                 {"intensity", 12, FLOAT32}, {"ring", 16, UINT16}, {"t_ns", 20, UINT32}};
   const size_t n = cloud.points.size();
-  CdrWriter w;
+  CdrWriter w(std::move(out));
   w.reserve(256 + n * kPointStep);
   header(w, cloud.stamp_ns, frame_id);
   w.u32(1);
@@ -160,7 +166,7 @@ Bytes encode_point_cloud(const PointCloud& cloud, const std::string& frame_id) {
     p += kPointStep;
   }
   w.boolean(true);
-  return std::move(w.buffer());
+  out = std::move(w.buffer());
 }
 
 PointCloud decode_point_cloud(View cdr, const std::string& context) {

@@ -48,6 +48,8 @@ using View = std::span<const uint8_t>;
 
 // sensor_msgs/msg/PointCloud2 in the layout above.
 Bytes encode_point_cloud(const PointCloud& cloud, const std::string& frame_id);
+// The same into `out`, reusing its allocation (a scan is about a megabyte).
+void encode_point_cloud(const PointCloud& cloud, const std::string& frame_id, Bytes& out);
 // Reads any little-endian PointCloud2 with FLOAT32/FLOAT64 x, y, z; intensity, ring and the point
 // time are optional and converted from whatever numeric type they have. The time is taken from
 // `t_ns`, `t` or `time_stamp` (nanoseconds), else from `time` (seconds, the Velodyne driver's).

@@ -1,0 +1,129 @@
+// lidarloop replay: a recorded run's streams, read back from its MCAP log, fed to the localizer in
+// the order they were recorded, and scored against the recorded ground truth. The scenario, seed and
+// method come from the log itself, so the estimates are those of the live run, bit for bit.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include "common/input_error.hpp"
+#include "localizer/localizer.hpp"
+#include "tools/commands.hpp"
+#include "tools/localizer_setup.hpp"
+#include "tools/mcap/log_topics.hpp"
+#include "tools/mcap/mcap_reader.hpp"
+#include "tools/mcap/ros2_messages.hpp"
+#include "tools/result_files.hpp"
+#include "tools/run_outputs.hpp"
+#include "tools/run_recording.hpp"
+
+namespace lidarloop {
+namespace {
+
+namespace topics = log_topics;
+
+struct RecordedRun {
+  std::string scenario_text, scenario_name;
+  std::map<std::string, std::string> metadata;
+};
+
+// The scenario and the run's settings, which the recorder writes before the first chunk.
+RecordedRun recorded_run(const McapReader& reader, const std::string& log) {
+  RecordedRun run;
+  for (const auto& a : reader.attachments())
+    if (a.name == kScenarioAttachment) run.scenario_text.assign(a.data.begin(), a.data.end());
+  for (const auto& m : reader.metadata())
+    if (m.name == kRunMetadata) run.metadata.insert(m.metadata.begin(), m.metadata.end());
+  if (run.scenario_text.empty() || run.metadata.empty())
+    throw InputError(log + ": no " + kScenarioAttachment + " attachment or " + kRunMetadata +
+                     " metadata: not a log recorded by lidarloop run or simulate");
+  run.scenario_name = run.metadata.count("scenario") ? run.metadata.at("scenario") : log;
+  return run;
+}
+
+int run_replay(const Args& args) {
+  const std::string log = args.positional().at(0);
+  McapReader reader(log);
+  McapMessage message;
+  bool more = reader.next(message);
+  const RecordedRun run = recorded_run(reader, log);
+
+  Scenario scenario =
+      parse_scenario(run.scenario_text, run.scenario_name, load_vehicle_params(data_dir() + "/assets/vehicle.yaml"));
+  try {
+    scenario.seed = std::stoull(run.metadata.at("seed"));
+  } catch (const std::exception&) {
+    throw InputError(log + ": metadata " + kRunMetadata + " has no valid seed");
+  }
+  const std::string recorded_method = run.metadata.count("method") ? run.metadata.at("method") : "";
+  std::optional<std::string> method = args.value("method");
+  if (!method && !recorded_method.empty()) method = recorded_method;
+  const LocalizerParams params = localizer_params_for(scenario, method);
+  const LoadedWorld world = load_world(scenario.world);
+  const ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
+  HdMap map = open_scenario_map(scenario);
+
+  Localizer localizer(map, params);
+  std::vector<TruthSample> truth;
+  std::vector<LocalizerEstimate> estimates;
+  std::optional<GpsFix> pending;  // a fix waits for its heading, recorded right after it
+  auto flush_gps = [&] {
+    if (pending) localizer.on_gps(*pending);
+    pending.reset();
+  };
+  size_t scans = 0;
+  for (; more; more = reader.next(message)) {
+    const std::string& topic = message.channel->topic;
+    const std::string context = log + " " + topic;
+    if (topic == topics::gps_heading && pending) {
+      const ros2::GnssHeading h = ros2::decode_gnss_heading(message.data, context);
+      if (h.stamp_ns == pending->stamp_ns) {
+        pending->heading_rad = h.heading;
+        pending->heading_variance = h.variance;
+      }
+      flush_gps();
+      continue;
+    }
+    flush_gps();
+    if (topic == topics::vehicle_report) {
+      localizer.on_can(ros2::decode_vehicle_report(message.data, context));
+    } else if (topic == topics::gps_fix) {
+      pending = ros2::decode_nav_sat_fix(message.data, context);
+    } else if (topic == topics::truth_state) {
+      truth.push_back(ros2::decode_truth_state(message.data, context));
+    } else if (topic == topics::scan) {
+      estimates.push_back(localizer.on_scan(ros2::decode_point_cloud(message.data, context)));
+      ++scans;
+    }
+  }
+  flush_gps();
+  if (truth.empty()) throw InputError(log + ": no " + std::string(topics::truth_state) + " messages to score against");
+
+  const std::string name = std::filesystem::path(run.scenario_name).stem().string();
+  const std::string out = args.text("out", "out/" + name + "-replay");
+  const ScoredRun scored =
+      score_and_write(out, name, scenario, resolved.ego_route, truth, method_name(params.method), estimates, nullptr, map);
+  std::cout << comparison_markdown({scored.metrics});
+  std::printf("\nlog        %s (%zu scans, seed %llu, recorded with %s)\n", log.c_str(), scans,
+              (unsigned long long)scenario.seed, recorded_method.empty() ? "no localizer" : recorded_method.c_str());
+  for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
+  std::printf("result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
+              "trajectory.png)\n",
+              scored.metrics.pass ? "PASS" : "FAIL", out.c_str());
+  return scored.metrics.pass ? 0 : 1;
+}
+
+}  // namespace
+
+Command replay_command() {
+  return {{"replay", "lidarloop replay FILE.mcap [--method NAME] [--out DIR]",
+           "Feed a log recorded by `run --record` or `simulate --record` to the localizer and score it\n"
+           "against the recorded ground truth, with the recorded scenario's thresholds. With the recorded\n"
+           "method, the estimates are the live run's, bit for bit. Exit codes as for run.",
+           {{"method", "NAME", "localizer method (default: the recorded one, else the scenario's)"},
+            {"out", "DIR", "output folder (default out/<scenario name>-replay)"}},
+           1, 1},
+          run_replay};
+}
+
+}  // namespace lidarloop
