@@ -26,6 +26,15 @@ namespace {
 // 30 m gives a few dozen; stray returns a handful).
 constexpr size_t kObstacleScanPoints = 20;
 
+// The scenario named on the command line, with --seed and --duration applied.
+LoadedScenario load_with_overrides(const Args& args) {
+  LoadedScenario s = load_scenario_and_world(args.positional().at(0));
+  if (args.value("seed")) s.scenario.seed = uint64_t(args.integer("seed", 0, 0, 1L << 62));
+  if (args.value("duration")) s.scenario.duration_s = args.number("duration", s.scenario.duration_s);
+  if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");
+  return s;
+}
+
 struct Progress {
   bool terminal = isatty(STDOUT_FILENO) != 0;
   std::string what;
@@ -45,10 +54,7 @@ void print_metrics_table(const std::vector<Metrics>& metrics) { std::cout << com
 int run_run(const Args& args) {
   const int threads = thread_count(args);
   const auto limit = limit_threads(threads);
-  LoadedScenario s = load_scenario_and_world(args.positional().at(0));
-  if (args.value("seed")) s.scenario.seed = uint64_t(args.integer("seed", 0, 0, 1L << 62));
-  if (args.value("duration")) s.scenario.duration_s = args.number("duration", s.scenario.duration_s);
-  if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");
+  LoadedScenario s = load_with_overrides(args);
   if (auto loop = args.value("loop")) {
     if (*loop != "open" && *loop != "closed") throw InputError("--loop must be open or closed, got '" + *loop + "'");
     s.scenario.closed_loop = *loop == "closed";
@@ -133,10 +139,7 @@ int expect_best(const std::vector<Metrics>& metrics, const std::string& method) 
 int run_compare(const Args& args) {
   const int threads = thread_count(args);
   const auto limit = limit_threads(threads);
-  LoadedScenario s = load_scenario_and_world(args.positional().at(0));
-  if (args.value("seed")) s.scenario.seed = uint64_t(args.integer("seed", 0, 0, 1L << 62));
-  if (args.value("duration")) s.scenario.duration_s = args.number("duration", s.scenario.duration_s);
-  if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");
+  LoadedScenario s = load_with_overrides(args);
   std::vector<LocalizerParams> params;
   for (const auto& m : parse_methods(args.text("methods", "all"))) params.push_back(localizer_params_for(s.scenario, m));
   const std::string name = std::filesystem::path(s.scenario.file).stem().string();
