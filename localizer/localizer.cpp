@@ -386,7 +386,10 @@ void Localizer::match_intensity(const std::vector<Eigen::Vector3d>& ground, cons
     e.health |= kIntensityMatchRejected;
     return;
   }
-  filter_->update_intensity(aps.position, R);  // KF2
+  if (params_.aps_longitudinal_only_with_curbs && e.curb_observation && !(e.health & kCurbMatchRejected))
+    filter_->update_intensity_along(aps.position, R, Eigen::Vector2d(std::cos(prior.yaw), std::sin(prior.yaw)));
+  else
+    filter_->update_intensity(aps.position, R);  // KF2
   e.stage_ms[size_t(Stage::fusion)] += watch.lap_ms();
 }
 

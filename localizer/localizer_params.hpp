@@ -99,6 +99,11 @@ struct LocalizerParams {
   double aps_max_lateral_range_m = 2.0, aps_max_longitudinal_range_m = 8.0;
   // APS's covariance (the spread of Eq. 14's distribution) times this is the observation noise.
   double aps_covariance_scale = 1.0;
+  // When the curbs were matched in the same scan, use APS only along the road. Across it the curbs
+  // are the better witness (section 3.2 searches only +-1 m there for that reason), and the paint
+  // that APS sees across a road is periodic: zebra stripes and parallel lane lines let a wrong
+  // lateral peak look sharp (seen as 3-6 cm lateral spikes at the crosswalks of dynamic_campus).
+  bool aps_longitudinal_only_with_curbs = true;
   VehicleModelParams vehicle;
   PoseFilterParams filter;
   double process_position_without_can_per_s = 2.0;  // m per s of dead reckoning without CAN

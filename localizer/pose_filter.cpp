@@ -79,4 +79,11 @@ void PoseFilter::update_intensity(const Eigen::Vector2d& z, const Eigen::Matrix2
   update<2>(z, R, H);
 }
 
+void PoseFilter::update_intensity_along(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& u) {
+  Eigen::Matrix<double, 1, 3> H = Eigen::Matrix<double, 1, 3>::Zero();
+  H(0, 0) = u.x();
+  H(0, 1) = u.y();
+  update<1>(Eigen::Matrix<double, 1, 1>(u.dot(z)), Eigen::Matrix<double, 1, 1>(u.dot(R * u)), H);
+}
+
 }  // namespace lidarloop
