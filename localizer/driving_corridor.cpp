@@ -15,6 +15,11 @@ Eigen::Vector2d world_to_vehicle(const Pose2d& pose, const Eigen::Vector2d& p_wo
   return {c * dx + s * dy, -s * dx + c * dy};
 }
 
+Eigen::Vector2d vehicle_to_world(const Pose2d& pose, const Eigen::Vector2d& p) {
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  return {pose.x + c * p.x() - s * p.y(), pose.y + s * p.x() + c * p.y()};
+}
+
 namespace {
 
 // Cell of a vehicle-frame point, shared by the projection (Eq. 1) and the queries so both agree.

@@ -45,6 +45,8 @@ struct DrivingCorridor {
 
 // World (local map frame, x east y north) -> vehicle frame (x forward, y left) for `pose`.
 Eigen::Vector2d world_to_vehicle(const Pose2d& pose, const Eigen::Vector2d& p_world);
+// And back: a vehicle-frame point placed in the local frame by `pose`.
+Eigen::Vector2d vehicle_to_world(const Pose2d& pose, const Eigen::Vector2d& p_vehicle);
 
 // curbs_world: curb points in the local map frame (e.g. CurbLayer::window around the pose). Curbs
 // outside the grid are ignored. With no curbs at all the whole grid is free, hence all corridor.

@@ -35,11 +35,6 @@ class Stopwatch {
 
 Eigen::Vector2d xy(const Pose2d& p) { return {p.x, p.y}; }
 
-Eigen::Vector2d to_world(const Pose2d& pose, const Eigen::Vector2d& p) {
-  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
-  return {pose.x + c * p.x() - s * p.y(), pose.y + s * p.x() + c * p.y()};
-}
-
 // b's pose relative to a, in a's frame.
 Odometry2d relative(const Pose2d& a, const Pose2d& b) {
   const double c = std::cos(a.yaw), s = std::sin(a.yaw);
@@ -279,7 +274,7 @@ void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, Locali
   const Pose2d prior = filter_->pose();
   std::vector<Eigen::Vector2d> world;
   world.reserve(features.size());
-  for (const auto& f : features) world.push_back(to_world(prior, f));
+  for (const auto& f : features) world.push_back(vehicle_to_world(prior, f));
 
   // Correspondences as far as the prior is uncertain (see icp_window_sigmas).
   const double sigma = std::sqrt(filter_->covariance().topLeftCorner<2, 2>().eigenvalues().real().maxCoeff());

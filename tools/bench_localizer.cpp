@@ -71,7 +71,7 @@ int bench_localizer(const Args& args) {
   s.scenario.duration_s = args.number("duration", 20.0);
   if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");
   const LocalizerParams params = localizer_params_for(s.scenario, args.value("method"));
-  HdMap map = open_scenario_map(s.scenario);
+  HdMap map = open_scenario_map(s.scenario, s.world);
 
   MemorySink recorded;
   {
@@ -98,7 +98,7 @@ int bench_loop(const Args& args) {
   s.scenario.duration_s = args.number("duration", 20.0);
   if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");
   const LocalizerParams params = localizer_params_for(s.scenario, args.value("method"));
-  HdMap map = open_scenario_map(s.scenario);
+  HdMap map = open_scenario_map(s.scenario, s.world);
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   const LoopResult r = run_localizer_loop(sim, map, {params}, true);
   const nlohmann::json result = {{"benchmark", "loop"},

@@ -61,7 +61,7 @@ int run_replay(const Args& args) {
   const LocalizerParams params = localizer_params_for(scenario, method);
   const LoadedWorld world = load_world(scenario.world);
   const ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
-  HdMap map = open_scenario_map(scenario);
+  HdMap map = open_scenario_map(scenario, world);
 
   Localizer localizer(map, params);
   std::vector<TruthSample> truth;

@@ -9,9 +9,7 @@
 #include <unistd.h>
 
 #include "common/input_error.hpp"
-#include "tools/birdseye.hpp"
 #include "tools/commands.hpp"
-#include "tools/error_plots.hpp"
 #include "tools/localizer_loop.hpp"
 #include "tools/localizer_setup.hpp"
 #include "tools/result_files.hpp"
@@ -49,7 +47,6 @@ struct Progress {
   }
 };
 
-void print_metrics_table(const std::vector<Metrics>& metrics) { std::cout << comparison_markdown(metrics); }
 
 int run_run(const Args& args) {
   const int threads = thread_count(args);
@@ -64,7 +61,7 @@ int run_run(const Args& args) {
   const std::string out = args.text("out", "out/" + name);
   std::filesystem::create_directories(out);
 
-  HdMap map = open_scenario_map(s.scenario);
+  HdMap map = open_scenario_map(s.scenario, s.world);
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_name(params.method), s.scenario.duration_s};
   const std::unique_ptr<McapRecorder> recorder =
@@ -83,7 +80,7 @@ int run_run(const Args& args) {
   const ScoredRun scored = score_and_write(out, name, s.scenario, sim.resolved().ego_route, r.truth, trace.method,
                                            trace.estimates, &trace.worst, map);
   const double lane_offset = scored.metrics.max_lane_offset_m;
-  print_metrics_table({scored.metrics});
+  std::cout << comparison_markdown({scored.metrics});
   std::printf("\nscenario   %s (seed %llu, %s loop), %.1f s simulated in %.1f s wall (%.1fx real time, %d thread(s))\n",
               s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.closed_loop ? "closed" : "open",
               s.scenario.duration_s, r.wall_s, s.scenario.duration_s / r.wall_s, threads);
@@ -146,7 +143,7 @@ int run_compare(const Args& args) {
   const std::string out = args.text("out", "out/" + name + "-compare");
   std::filesystem::create_directories(out);
 
-  HdMap map = open_scenario_map(s.scenario);
+  HdMap map = open_scenario_map(s.scenario, s.world);
   // Open loop: every method sees the same drive; in closed loop each would drive its own.
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   const Progress progress{isatty(STDOUT_FILENO) != 0, "compare", s.scenario.duration_s};

@@ -23,7 +23,6 @@ class LoopSink : public StreamSink {
 
   void on_truth(const TruthSample& t) override {
     result_.truth.push_back(t);
-    result_.max_cross_track_m = std::max(result_.max_cross_track_m, std::abs(t.cross_track));
     if (also_) also_->on_truth(t);
   }
   void on_can(const CanFrame& f) override {
@@ -62,7 +61,6 @@ class LoopSink : public StreamSink {
     }
   }
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override {
-    result_.actors.push_back(actors);
     if (also_) also_->on_actors(stamp_ns, actors);
   }
 

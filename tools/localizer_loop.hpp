@@ -31,10 +31,8 @@ struct MethodTrace {
 struct LoopResult {
   std::vector<TruthSample> truth;
   std::vector<MethodTrace> methods;
-  std::vector<std::vector<ActorSample>> actors;  // per scan
   double wall_s = 0;            // whole loop
   double localizer_wall_s = 0;  // inside the localizers
-  double max_cross_track_m = 0; // how far the controller strayed from its lane's centre
   size_t scans = 0;
 };
 

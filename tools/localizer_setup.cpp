@@ -16,9 +16,9 @@ LoadedScenario load_scenario_and_world(const std::string& path) {
   return {std::move(scenario), std::move(world), std::move(resolved)};
 }
 
-HdMap open_scenario_map(const Scenario& scenario) {
+HdMap open_scenario_map(const Scenario& scenario, const LoadedWorld& world) {
   const MapLocation map = ensure_map(scenario.world, MappingOptions{}, false);
-  return open_hd_map(map.dir, load_world(scenario.world).description.name);
+  return open_hd_map(map.dir, world.description.name);
 }
 
 LocalizerParams localizer_params_for(const Scenario& s, const std::optional<std::string>& method) {

@@ -20,8 +20,9 @@ struct LoadedScenario {
 // InputError naming the file for anything wrong with the scenario or its world.
 LoadedScenario load_scenario_and_world(const std::string& path);
 
-// Finds or builds the map of the scenario's world (progress on a terminal) and opens it.
-HdMap open_scenario_map(const Scenario& scenario);
+// Finds or builds the map of the scenario's world (progress on a terminal) and opens it, checking
+// that it is the map of `world`.
+HdMap open_scenario_map(const Scenario& scenario, const LoadedWorld& world);
 
 // The localizer configuration of a scenario; `method` overrides the scenario's own.
 LocalizerParams localizer_params_for(const Scenario& scenario, const std::optional<std::string>& method = {});

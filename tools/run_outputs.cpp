@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "localizer/driving_corridor.hpp"
 #include "tools/birdseye.hpp"
 #include "tools/error_plots.hpp"
 #include "tools/result_files.hpp"
@@ -15,9 +16,7 @@ void write_worst_frame(const std::string& path, const WorstFrame& w, const HdMap
   if (w.error_m < 0) return;
   auto place = [&](const std::vector<Eigen::Vector2d>& vehicle_points) {
     std::vector<Eigen::Vector2d> world;
-    const double c = std::cos(w.estimate.yaw), s = std::sin(w.estimate.yaw);
-    for (const auto& p : vehicle_points)
-      world.emplace_back(w.estimate.x + c * p.x() - s * p.y(), w.estimate.y + s * p.x() + c * p.y());
+    for (const auto& p : vehicle_points) world.push_back(vehicle_to_world(w.estimate, p));
     return world;
   };
   BirdseyeOptions o;
