@@ -109,8 +109,33 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
   const Eigen::Matrix2d R = rotation(S.pose.yaw);
   const Eigen::Vector2d origin(S.pose.x, S.pose.y);
 
+  // Usable cells of S (S_n > n_e), and a summed-area table of them: a window cell matters only if some
+  // usable S cell looks at it at some offset, and on a road most of S is empty (the corridor's ground
+  // only), so most of the window need not be read from the map at all.
+  const uint32_t min_count = uint32_t(std::max(params.min_count, 0));
+  auto usable = [&](int c, int r) { return S.cells[size_t(r) * size_t(w) + size_t(c)].count > min_count; };
+  std::vector<int> usable_sat(size_t(w + 1) * size_t(h + 1), 0);
+  for (int r = 0; r < h; ++r) {
+    int row_usable = 0;
+    for (int c = 0; c < w; ++c) {
+      row_usable += usable(c, r) ? 1 : 0;
+      usable_sat[size_t(r + 1) * size_t(w + 1) + size_t(c + 1)] =
+          usable_sat[size_t(r) * size_t(w + 1) + size_t(c + 1)] + row_usable;
+    }
+  }
+  // S cell (c, r) looks at window cells [c, c + 2 margin_x] x [r, r + 2 margin_y], so window cell
+  // (wc, wr) is needed if S has a usable cell in [wc - 2 margin_x, wc] x [wr - 2 margin_y, wr].
+  auto needed = [&](int wc, int wr) {
+    const int c0 = std::max(wc - 2 * margin_x, 0), c1 = std::min(wc, w - 1);
+    const int r0 = std::max(wr - 2 * margin_y, 0), r1 = std::min(wr, h - 1);
+    if (c0 > c1 || r0 > r1) return false;
+    auto at = [&](int c, int r) { return usable_sat[size_t(r) * size_t(w + 1) + size_t(c)]; };
+    return at(c1 + 1, r1 + 1) - at(c0, r1 + 1) - at(c1 + 1, r0) + at(c0, r0) > 0;
+  };
+
   // The map under the vehicle-frame window: mean, floored standard deviation, and a summed-area table
-  // of the cells without data (to ask in O(1) whether an S cell stays on the map at every offset).
+  // of the cells without data (to ask in O(1) whether an S cell stays on the map at every offset; a cell
+  // nobody needs counts as present, which no question can tell apart).
   // Single precision for the search: intensities are whole counts 0-255 and the sums a few thousand
   // z-scores, far inside float's 7 digits, and the inner loop does twice the offsets per instruction.
   std::vector<float> map_mean(size_t(ww) * size_t(wh), 0.0f), map_sigma(size_t(ww) * size_t(wh), float(params.min_sigma));
@@ -118,17 +143,19 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
   for (int r = 0; r < wh; ++r) {
     int row_missing = 0;
     for (int c = 0; c < ww; ++c) {
-      const Eigen::Vector2d local = origin + R * S.cell_centre(c - margin_x, r - margin_y);
-      const std::optional<IntensityCell> m = map.cell(local);
-      const size_t k = size_t(r) * size_t(ww) + size_t(c);
-      if (m && m->count > 0) {
-        map_mean[k] = float(m->mean);
-        // Eq. 14 as printed adds variances and squares the sum, which is dimensionally intensity^4
-        // over intensity^2; reading sigma as the standard deviation makes the exponent a squared
-        // z-score, as in APS.
-        map_sigma[k] = float(std::max(std::sqrt(m->variance()), params.min_sigma));
-      } else {
-        ++row_missing;
+      if (needed(c, r)) {
+        const Eigen::Vector2d local = origin + R * S.cell_centre(c - margin_x, r - margin_y);
+        const std::optional<IntensityCell> m = map.cell(local);
+        const size_t k = size_t(r) * size_t(ww) + size_t(c);
+        if (m && m->count > 0) {
+          map_mean[k] = float(m->mean);
+          // Eq. 14 as printed adds variances and squares the sum, which is dimensionally intensity^4
+          // over intensity^2; reading sigma as the standard deviation makes the exponent a squared
+          // z-score, as in APS.
+          map_sigma[k] = float(std::max(std::sqrt(m->variance()), params.min_sigma));
+        } else {
+          ++row_missing;
+        }
       }
       missing_sat[size_t(r + 1) * size_t(ww + 1) + size_t(c + 1)] =
           missing_sat[size_t(r) * size_t(ww + 1) + size_t(c + 1)] + row_missing;
@@ -147,8 +174,8 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
   int used = 0;
   for (int r = 0; r < h; ++r) {
     for (int c = 0; c < w; ++c) {
+      if (!usable(c, r)) continue;  // effective area: S_n > n_e
       const IntensityCell& s = S.cells[size_t(r) * size_t(w) + size_t(c)];
-      if (s.count <= uint32_t(std::max(params.min_count, 0))) continue;  // effective area: S_n > n_e
       // Window cell (c, r) is S cell (c, r) shifted by the most negative offset.
       if (missing_in(c, r, 2 * margin_x + 1, 2 * margin_y + 1) != 0) continue;
       ++used;

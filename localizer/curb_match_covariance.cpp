@@ -19,8 +19,8 @@ CurbMatchQuality curb_match_quality(const std::vector<Eigen::Vector2d>& curbs_ve
   // Point-to-line residual r = n^T (t + R f - m); its Jacobian by (x, y, psi) is (n_x, n_y, n^T dR f).
   Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
   for (const Eigen::Vector2d& f : curbs_vehicle) {
-    const auto [index, distance] = map.nearest(t + R * f);
-    if (!(distance <= noise.inlier_distance_m) || index >= map_tangents.size()) continue;
+    const size_t index = map.nearest_within(t + R * f, noise.inlier_distance_m).first;
+    if (index >= map_tangents.size()) continue;
     const Eigen::Vector2d n(-map_tangents[index].y(), map_tangents[index].x());
     const Eigen::Vector3d J(n.x(), n.y(), n.dot(dR * f));
     information.noalias() += J * J.transpose();
