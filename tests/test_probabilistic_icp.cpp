@@ -92,6 +92,40 @@ TEST(IcpMapIndex, NearestPointAndDistance) {
   EXPECT_TRUE(std::isinf(MapIndex({}).nearest({0, 0}).second));
 }
 
+// The buckets must give the KD-tree's answer whenever it lies within the gate, and nothing otherwise,
+// for gates up to a bucket (buckets) and beyond (tree), inside the map and far off it.
+TEST(IcpMapIndex, NearestWithinAgreesWithTheTree) {
+  const std::vector<Eigen::Vector2d> map = road_map();
+  const MapIndex index(map);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-45, 45);
+  size_t found = 0;
+  for (double gate : {0.05, 0.3, 1.0, 2.5}) {
+    for (int k = 0; k < 2000; ++k) {
+      const Eigen::Vector2d q(u(rng), u(rng));
+      const auto [ti, td] = index.nearest(q);
+      const auto [bi, bd] = index.nearest_within(q, gate);
+      if (td <= gate) {
+        ASSERT_NEAR(bd, td, 1e-12) << "query " << q.transpose() << " gate " << gate;
+        ++found;
+      } else {
+        ASSERT_EQ(bi, SIZE_MAX) << "query " << q.transpose() << " gate " << gate;
+        ASSERT_TRUE(std::isinf(bd));
+      }
+    }
+  }
+  EXPECT_GT(found, 200u);  // the queries did land near curbs often enough to test something
+  // A point exactly on the gate counts; NaN and far-away queries find nothing, without a crash.
+  EXPECT_EQ(MapIndex({{0, 0}, {3, 0}}).nearest_within({0.0, 0.5}, 0.5).first, 0u);
+  EXPECT_EQ(index.nearest_within({std::nan(""), 0.0}, 1.0).first, SIZE_MAX);
+  EXPECT_EQ(index.nearest_within({1e300, -1e300}, 1.0).first, SIZE_MAX);
+  EXPECT_EQ(MapIndex({}).nearest_within({0, 0}, 1.0).first, SIZE_MAX);
+  // Two points 10 km apart: the buckets grow rather than allocate 10^8 of them, and still find both.
+  const MapIndex sparse({{0, 0}, {1e4, 1e4}});
+  EXPECT_EQ(sparse.nearest_within({0.3, 0.0}, 0.5).first, 0u);
+  EXPECT_EQ(sparse.nearest_within({1e4, 1e4 + 0.2}, 0.5).first, 1u);
+}
+
 TEST(IcpFitRigid, RecoversKnownTransformExactly) {
   const Transform2d truth{-1.7, 0.4, 2.5};  // a large rotation: no small-angle shortcut
   std::mt19937_64 rng(7);
