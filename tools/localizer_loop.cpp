@@ -2,17 +2,29 @@
 
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <variant>
 
 namespace lidarloop {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-class LoopSink : public StreamSink {
+struct ScanMessage {
+  PointCloud cloud;
+  Eigen::Isometry3d sensor_pose;
+};
+// What the localizers consume, in the order the simulation emitted it.
+using Message = std::variant<TruthSample, CanFrame, GpsFix, ScanMessage>;
+
+// The localizers and what they produced. One thread at a time calls process(); nothing else is shared.
+class Localizers {
  public:
-  LoopSink(HdMap& map, const std::vector<LocalizerParams>& methods, StreamSink* also,
-           const std::function<void(const LocalizerEstimate&)>& on_estimate, LoopResult& result)
-      : also_(also), on_estimate_(on_estimate), result_(result) {
+  Localizers(HdMap& map, const std::vector<LocalizerParams>& methods, LoopResult& result) : result_(result) {
     for (const auto& p : methods) {
       localizers_.push_back(std::make_unique<Localizer>(map, p));
       result_.methods.push_back({method_name(p.method), {}, {}});
@@ -21,61 +33,223 @@ class LoopSink : public StreamSink {
 
   const Localizer& primary() const { return *localizers_.front(); }
 
+  // Returns the first method's estimate for a scan, nothing for the other messages.
+  std::optional<LocalizerEstimate> process(const Message& m) {
+    const auto t0 = Clock::now();
+    std::optional<LocalizerEstimate> primary;
+    if (const auto* t = std::get_if<TruthSample>(&m)) latest_truth_ = t->pose;
+    if (const auto* f = std::get_if<CanFrame>(&m))
+      for (auto& l : localizers_) l->on_can(*f);
+    if (const auto* f = std::get_if<GpsFix>(&m))
+      for (auto& l : localizers_) l->on_gps(*f);
+    if (const auto* s = std::get_if<ScanMessage>(&m)) {
+      for (size_t i = 0; i < localizers_.size(); ++i) {
+        LocalizerEstimate e = localizers_[i]->on_scan(s->cloud);
+        MethodTrace& trace = result_.methods[i];
+        // The latest truth sample is at most one truth period from the estimate: close enough to pick
+        // the worst frame (the scorer interpolates properly).
+        if (latest_truth_ && !(e.health & kNotInitialized)) {
+          const double error = std::hypot(e.pose.x - latest_truth_->x, e.pose.y - latest_truth_->y);
+          if (error > trace.worst.error_m)
+            trace.worst = {error, s->cloud, s->sensor_pose, localizers_[i]->last_features(), *latest_truth_, e.pose};
+        }
+        if (i == 0) primary = e;
+        trace.estimates.push_back(std::move(e));
+      }
+    }
+    result_.localizer_wall_s += std::chrono::duration<double>(Clock::now() - t0).count();
+    return primary;
+  }
+
+ private:
+  std::vector<std::unique_ptr<Localizer>> localizers_;
+  std::optional<Pose2d> latest_truth_;
+  LoopResult& result_;
+};
+
+// Open loop: the localizers run on a thread of their own while the simulation computes the next
+// scan, so the two cores are both busy. Nothing the simulation does depends on the estimates, and
+// the localizers see the same messages in the same order as in series, so the results are the same.
+// The recorder (`also`) still sees everything in the serial order: scan k, its estimate, the messages
+// up to scan k + 1. Messages after scan k are held back until estimate k is out, which the
+// simulation waits for at scan k + 1 at the latest.
+class PipelinedSink : public StreamSink {
+ public:
+  PipelinedSink(Localizers& localizers, StreamSink* also, const std::function<void(const LocalizerEstimate&)>& on_estimate)
+      : localizers_(localizers), also_(also), on_estimate_(on_estimate), worker_([this] { work(); }) {}
+  ~PipelinedSink() override { stop(); }
+
   void on_truth(const TruthSample& t) override {
-    result_.truth.push_back(t);
+    push(t);
+    hold([this, t] { also_->on_truth(t); });
+  }
+  void on_can(const CanFrame& f) override {
+    push(f);
+    hold([this, f] { also_->on_can(f); });
+  }
+  void on_gps(const GpsFix& f) override {
+    push(f);
+    hold([this, f] { also_->on_gps(f); });
+  }
+  void on_rtk(const GpsFix& f) override {
+    hold([this, f] { also_->on_rtk(f); });
+  }
+  void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override {
+    hold([this, stamp_ns, actors] { also_->on_actors(stamp_ns, actors); });
+  }
+  void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
+    release_previous_scan();
+    if (also_) also_->on_scan(cloud, sensor_pose);
+    push(ScanMessage{cloud, sensor_pose});
+    scan_outstanding_ = true;
+  }
+
+  // Waits for the last scan's estimate, hands out everything held back and stops the worker once it
+  // has processed everything; rethrows what the localizers threw. Call after the run.
+  void finish() {
+    release_previous_scan();
+    stop();
+    if (failure_) std::rethrow_exception(failure_);
+  }
+
+ private:
+  void stop() {
+    if (!worker_.joinable()) return;
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    wake_worker_.notify_one();
+    worker_.join();
+  }
+  void push(Message m) {
+    {
+      std::lock_guard lock(mutex_);
+      queue_.push_back(std::move(m));
+    }
+    wake_worker_.notify_one();
+  }
+  void hold(std::function<void()> f) {
+    if (!also_) return;
+    if (scan_outstanding_)
+      held_.push_back(std::move(f));
+    else
+      f();
+  }
+  void release_previous_scan() {
+    if (!scan_outstanding_) return;
+    LocalizerEstimate e;
+    {
+      std::unique_lock lock(mutex_);
+      estimate_ready_.wait(lock, [this] { return !estimates_.empty() || failure_; });
+      if (failure_) std::rethrow_exception(failure_);
+      e = std::move(estimates_.front());
+      estimates_.pop_front();
+    }
+    scan_outstanding_ = false;
+    if (on_estimate_) on_estimate_(e);
+    for (auto& f : held_) f();
+    held_.clear();
+  }
+
+  void work() {
+    for (;;) {
+      Message m;
+      {
+        std::unique_lock lock(mutex_);
+        wake_worker_.wait(lock, [this] { return !queue_.empty() || stop_; });
+        if (queue_.empty()) return;  // stopped, and everything processed
+        m = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      try {
+        std::optional<LocalizerEstimate> e = localizers_.process(m);
+        if (e) {
+          std::lock_guard lock(mutex_);
+          estimates_.push_back(std::move(*e));
+        }
+        if (e) estimate_ready_.notify_one();
+      } catch (...) {
+        std::lock_guard lock(mutex_);
+        failure_ = std::current_exception();
+        estimate_ready_.notify_one();
+        return;
+      }
+    }
+  }
+
+  Localizers& localizers_;
+  StreamSink* also_;
+  std::function<void(const LocalizerEstimate&)> on_estimate_;
+  bool scan_outstanding_ = false;              // simulation thread only
+  std::vector<std::function<void()>> held_;    // simulation thread only
+  std::mutex mutex_;                           // guards the four below
+  std::condition_variable wake_worker_, estimate_ready_;
+  std::deque<Message> queue_;
+  std::deque<LocalizerEstimate> estimates_;
+  std::exception_ptr failure_;
+  bool stop_ = false;
+  std::thread worker_;  // last: starts once everything above exists
+};
+
+// Closed loop: the controller asks for the estimate between scans, so the localizers run in series
+// with the simulation, each message as it comes.
+class SerialSink : public StreamSink {
+ public:
+  SerialSink(Localizers& localizers, StreamSink* also, const std::function<void(const LocalizerEstimate&)>& on_estimate)
+      : localizers_(localizers), also_(also), on_estimate_(on_estimate) {}
+
+  void on_truth(const TruthSample& t) override {
+    localizers_.process(t);
     if (also_) also_->on_truth(t);
   }
   void on_can(const CanFrame& f) override {
-    timed([&] {
-      for (auto& l : localizers_) l->on_can(f);
-    });
+    localizers_.process(f);
     if (also_) also_->on_can(f);
   }
   void on_gps(const GpsFix& f) override {
-    timed([&] {
-      for (auto& l : localizers_) l->on_gps(f);
-    });
+    localizers_.process(f);
     if (also_) also_->on_gps(f);
   }
   void on_rtk(const GpsFix& f) override {
     if (also_) also_->on_rtk(f);
   }
-  void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
-    if (also_) also_->on_scan(cloud, sensor_pose);
-    ++result_.scans;
-    for (size_t i = 0; i < localizers_.size(); ++i) {
-      LocalizerEstimate e;
-      timed([&] { e = localizers_[i]->on_scan(cloud); });
-      MethodTrace& trace = result_.methods[i];
-      // The latest truth sample is at most one truth period from the estimate: close enough to pick
-      // the worst frame (the scorer interpolates properly).
-      if (!result_.truth.empty() && !(e.health & kNotInitialized)) {
-        const Pose2d& truth = result_.truth.back().pose;
-        const double error = std::hypot(e.pose.x - truth.x, e.pose.y - truth.y);
-        if (error > trace.worst.error_m) {
-          trace.worst = {error, cloud, sensor_pose, localizers_[i]->last_features(), truth, e.pose};
-        }
-      }
-      if (i == 0 && on_estimate_) on_estimate_(e);
-      trace.estimates.push_back(std::move(e));
-    }
-  }
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override {
     if (also_) also_->on_actors(stamp_ns, actors);
   }
-
- private:
-  template <class F>
-  void timed(F&& f) {
-    const auto t0 = Clock::now();
-    f();
-    result_.localizer_wall_s += std::chrono::duration<double>(Clock::now() - t0).count();
+  void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
+    if (also_) also_->on_scan(cloud, sensor_pose);
+    const std::optional<LocalizerEstimate> e = localizers_.process(ScanMessage{cloud, sensor_pose});
+    if (e && on_estimate_) on_estimate_(*e);
   }
 
-  std::vector<std::unique_ptr<Localizer>> localizers_;
+ private:
+  Localizers& localizers_;
   StreamSink* also_;
   std::function<void(const LocalizerEstimate&)> on_estimate_;
-  LoopResult& result_;
+};
+
+// The scorer wants the truth too; it is collected in the simulation thread, before either sink.
+class TruthTap : public StreamSink {
+ public:
+  TruthTap(StreamSink& next, std::vector<TruthSample>& truth, size_t& scans) : next_(next), truth_(truth), scans_(scans) {}
+  void on_truth(const TruthSample& t) override {
+    truth_.push_back(t);
+    next_.on_truth(t);
+  }
+  void on_can(const CanFrame& f) override { next_.on_can(f); }
+  void on_gps(const GpsFix& f) override { next_.on_gps(f); }
+  void on_rtk(const GpsFix& f) override { next_.on_rtk(f); }
+  void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& a) override { next_.on_actors(stamp_ns, a); }
+  void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
+    ++scans_;
+    next_.on_scan(cloud, sensor_pose);
+  }
+
+ private:
+  StreamSink& next_;
+  std::vector<TruthSample>& truth_;
+  size_t& scans_;
 };
 
 }  // namespace
@@ -85,14 +259,21 @@ LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<Loc
                               const std::function<void(const LocalizerEstimate&)>& on_estimate) {
   LoopResult result;
   if (methods.empty()) return result;
-  LoopSink sink(map, methods, also, on_estimate, result);
-  if (closed_loop) {
-    sim.set_pose_source([&sink](int64_t, const Pose2d& truth) { return sink.primary().pose().value_or(truth); });
-  }
+  Localizers localizers(map, methods, result);
   const auto t0 = Clock::now();
-  sim.run(sink, progress);
+  if (closed_loop) {
+    SerialSink sink(localizers, also, on_estimate);
+    TruthTap tap(sink, result.truth, result.scans);
+    sim.set_pose_source([&localizers](int64_t, const Pose2d& truth) { return localizers.primary().pose().value_or(truth); });
+    sim.run(tap, progress);
+    sim.set_pose_source({});
+  } else {
+    PipelinedSink sink(localizers, also, on_estimate);
+    TruthTap tap(sink, result.truth, result.scans);
+    sim.run(tap, progress);
+    sink.finish();
+  }
   result.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  if (closed_loop) sim.set_pose_source({});
   return result;
 }
 
