@@ -7,7 +7,20 @@
 #include <Eigen/Geometry>
 #include <nanoflann.hpp>
 
+#include "localizer/probabilistic_icp.hpp"
+
 namespace lidarloop {
+
+Odometry2d relative(const Pose2d& a, const Pose2d& b) {
+  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  return {c * dx + s * dy, -s * dx + c * dy, wrap_angle(b.yaw - a.yaw)};
+}
+
+Pose2d compose(const Pose2d& a, const Odometry2d& d) {
+  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
+  return {a.x + c * d.dx - s * d.dy, a.y + s * d.dx + c * d.dy, wrap_angle(a.yaw + d.dpsi)};
+}
 
 std::vector<Eigen::Vector2d> to_current_frame(const std::vector<Eigen::Vector2d>& previous, const Odometry2d& m) {
   const Eigen::Rotation2D<double> back(-m.dpsi);

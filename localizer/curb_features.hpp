@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include "common/vehicle_messages.hpp"
+
 namespace lidarloop {
 
 struct CurbFeatureParams {
@@ -21,6 +23,11 @@ struct CurbFeatureParams {
 struct Odometry2d {
   double dx = 0, dy = 0, dpsi = 0;
 };
+
+// b's pose relative to a, in a's frame: the motion from a to b.
+Odometry2d relative(const Pose2d& a, const Pose2d& b);
+// a moved by d (d in a's frame).
+Pose2d compose(const Pose2d& a, const Odometry2d& d);
 
 // Eq. 5: where points of the previous vehicle frame are in the current one: R(-dpsi) (C - d). (The
 // paper prints R(dpsi); with dpsi the vehicle's own turn, the points turn the other way.)

@@ -35,19 +35,12 @@ class Stopwatch {
 
 Eigen::Vector2d xy(const Pose2d& p) { return {p.x, p.y}; }
 
-// b's pose relative to a, in a's frame.
-Odometry2d relative(const Pose2d& a, const Pose2d& b) {
-  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
-  const double dx = b.x - a.x, dy = b.y - a.y;
-  return {c * dx + s * dy, -s * dx + c * dy, wrap_angle(b.yaw - a.yaw)};
-}
-
-Pose2d compose(const Pose2d& a, const Odometry2d& d) {
-  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
-  return {a.x + c * d.dx - s * d.dy, a.y + s * d.dx + c * d.dy, wrap_angle(a.yaw + d.dpsi)};
-}
-
 }  // namespace
+
+CanMotion can_motion(const CanFrame& f, const VehicleModelParams& vehicle) {
+  return {0.5 * (f.wheel_speed_mps[2] + f.wheel_speed_mps[3]),  // rear axle centre
+          f.steering_wheel_angle_rad / vehicle.steering_ratio};
+}
 
 std::string describe_health(uint32_t flags) {
   static const std::array<const char*, kHealthFlagCount> names = {
@@ -110,12 +103,11 @@ void Localizer::predict_to(int64_t t_ns) {
 
 void Localizer::on_can(const CanFrame& f) {
   if (last_can_ns_ && f.stamp_ns < *last_can_ns_) return;  // out of order: stale news
-  const double speed = 0.5 * (f.wheel_speed_mps[2] + f.wheel_speed_mps[3]);  // rear axle centre
-  const double steer = f.steering_wheel_angle_rad / params_.vehicle.steering_ratio;
-  if (!std::isfinite(speed) || !std::isfinite(steer)) return;
+  const CanMotion m = can_motion(f, params_.vehicle);
+  if (!std::isfinite(m.speed) || !std::isfinite(m.steer)) return;
   predict_to(f.stamp_ns);  // with the previous frame's values, held until now
-  speed_ = speed;
-  steer_ = steer;
+  speed_ = m.speed;
+  steer_ = m.steer;
   last_can_ns_ = f.stamp_ns;
 }
 

@@ -76,6 +76,13 @@ struct ScanFeatures {
   std::vector<Eigen::Vector2d> curbs, obstacles;
 };
 
+// What drives Eq. 19 in a CAN frame: the rear axle centre's speed (mean of the rear wheels, m/s) and
+// the front wheel angle (steering wheel angle over the steering ratio, rad).
+struct CanMotion {
+  double speed = 0, steer = 0;
+};
+CanMotion can_motion(const CanFrame& f, const VehicleModelParams& vehicle);
+
 class Localizer {
  public:
   // `map` must outlive the localizer (its intensity layer loads tiles as the car moves).

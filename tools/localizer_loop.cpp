@@ -5,6 +5,8 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <algorithm>
+#include <optional>
 #include <mutex>
 #include <thread>
 #include <variant>
@@ -30,8 +32,6 @@ class Localizers {
       result_.methods.push_back({method_name(p.method), {}, {}});
     }
   }
-
-  const Localizer& primary() const { return *localizers_.front(); }
 
   // Returns the first method's estimate for a scan, nothing for the other messages.
   std::optional<LocalizerEstimate> process(const Message& m) {
@@ -67,9 +67,9 @@ class Localizers {
   LoopResult& result_;
 };
 
-// Open loop: the localizers run on a thread of their own while the simulation computes the next
-// scan, so the two cores are both busy. Nothing the simulation does depends on the estimates, and
-// the localizers see the same messages in the same order as in series, so the results are the same.
+// The localizers run on a thread of their own while the simulation computes the next scan, so the two
+// cores are both busy. The localizers see the same messages in the same order as in series, so they
+// give the same estimates; in closed loop the controller gets them a scan late (see DelayedPose).
 // The recorder (`also`) still sees everything in the serial order: scan k, its estimate, the messages
 // up to scan k + 1. Messages after scan k are held back until estimate k is out, which the
 // simulation waits for at scan k + 1 at the latest.
@@ -192,52 +192,83 @@ class PipelinedSink : public StreamSink {
   std::thread worker_;  // last: starts once everything above exists
 };
 
-// Closed loop: the controller asks for the estimate between scans, so the localizers run in series
-// with the simulation, each message as it comes.
-class SerialSink : public StreamSink {
+// The controller's pose in closed loop. The localizer runs beside the simulation, so estimate k is
+// not there while scan k is being processed: the controller steers on the newest estimate handed out
+// (the previous scan's, 0.1-0.2 s old) brought up to the present with CAN odometry (Eq. 19), which is
+// what a real car's controller does with a localizer's output. Which estimate is the newest depends
+// only on the simulation's events (estimate k is handed out at scan k + 1), never on how fast the
+// worker is, so closed-loop runs stay deterministic. Until the first estimate: ground truth.
+class DelayedPose {
  public:
-  SerialSink(Localizers& localizers, StreamSink* also, const std::function<void(const LocalizerEstimate&)>& on_estimate)
-      : localizers_(localizers), also_(also), on_estimate_(on_estimate) {}
+  explicit DelayedPose(const LocalizerParams& params) : params_(params) {}
 
-  void on_truth(const TruthSample& t) override {
-    localizers_.process(t);
-    if (also_) also_->on_truth(t);
+  void on_can(const CanFrame& f) {
+    const CanMotion m = can_motion(f, params_.vehicle);
+    if (!std::isfinite(m.speed) || !std::isfinite(m.steer)) return;
+    if (!history_.empty() && f.stamp_ns < history_.back().stamp_ns) return;  // stale, as the localizer
+    Odometry o = history_.empty() ? Odometry{f.stamp_ns, {}, {}, MotionPredictor(params_.vehicle)}
+                                  : advanced(history_.back(), f.stamp_ns);
+    o.motion = m;
+    history_.push_back(o);
+    // Keep what a handed-out estimate can still be referred to.
+    const int64_t keep_from = estimate_ ? estimate_->stamp_ns : f.stamp_ns - kKeepWithoutEstimateNs;
+    while (history_.size() > 1 && history_[1].stamp_ns <= keep_from) history_.pop_front();
   }
-  void on_can(const CanFrame& f) override {
-    localizers_.process(f);
-    if (also_) also_->on_can(f);
+  void on_estimate(const LocalizerEstimate& e) {
+    if (!(e.health & kNotInitialized)) estimate_ = Stamped{e.stamp_ns, e.pose};
   }
-  void on_gps(const GpsFix& f) override {
-    localizers_.process(f);
-    if (also_) also_->on_gps(f);
-  }
-  void on_rtk(const GpsFix& f) override {
-    if (also_) also_->on_rtk(f);
-  }
-  void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override {
-    if (also_) also_->on_actors(stamp_ns, actors);
-  }
-  void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
-    if (also_) also_->on_scan(cloud, sensor_pose);
-    const std::optional<LocalizerEstimate> e = localizers_.process(ScanMessage{cloud, sensor_pose});
-    if (e && on_estimate_) on_estimate_(*e);
+  Pose2d pose(int64_t t_ns, const Pose2d& truth) const {
+    if (!estimate_ || history_.empty()) return truth;
+    return compose(estimate_->pose, relative(odometry_at(estimate_->stamp_ns), odometry_at(t_ns)));
   }
 
  private:
-  Localizers& localizers_;
-  StreamSink* also_;
-  std::function<void(const LocalizerEstimate&)> on_estimate_;
+  static constexpr int64_t kKeepWithoutEstimateNs = 1'000'000'000;
+  struct Stamped {
+    int64_t stamp_ns;
+    Pose2d pose;
+  };
+  // Dead reckoning in a frame of its own, as of a CAN frame, with that frame's speed and steering.
+  struct Odometry {
+    int64_t stamp_ns;
+    Pose2d pose;
+    CanMotion motion;
+    MotionPredictor predictor;
+  };
+  // `o` driven on to t_ns in the localizer's Euler steps.
+  Odometry advanced(Odometry o, int64_t t_ns) const {
+    const int64_t max_step = std::max<int64_t>(1, int64_t(params_.max_prediction_step_s * 1e9));
+    while (o.stamp_ns < t_ns) {
+      const int64_t h = std::min(max_step, t_ns - o.stamp_ns);
+      o.pose = o.predictor.predict(o.pose, o.motion.speed, o.motion.steer, double(h) * 1e-9);
+      o.stamp_ns += h;
+    }
+    return o;
+  }
+  Pose2d odometry_at(int64_t t_ns) const {
+    auto after = std::upper_bound(history_.begin(), history_.end(), t_ns,
+                                  [](int64_t t, const Odometry& o) { return t < o.stamp_ns; });
+    return advanced(after == history_.begin() ? history_.front() : *std::prev(after), t_ns).pose;
+  }
+
+  const LocalizerParams& params_;
+  std::deque<Odometry> history_;
+  std::optional<Stamped> estimate_;
 };
 
 // The scorer wants the truth too; it is collected in the simulation thread, before either sink.
 class TruthTap : public StreamSink {
  public:
-  TruthTap(StreamSink& next, std::vector<TruthSample>& truth, size_t& scans) : next_(next), truth_(truth), scans_(scans) {}
+  TruthTap(StreamSink& next, std::vector<TruthSample>& truth, size_t& scans, DelayedPose* controller_pose)
+      : next_(next), truth_(truth), scans_(scans), controller_pose_(controller_pose) {}
   void on_truth(const TruthSample& t) override {
     truth_.push_back(t);
     next_.on_truth(t);
   }
-  void on_can(const CanFrame& f) override { next_.on_can(f); }
+  void on_can(const CanFrame& f) override {
+    if (controller_pose_) controller_pose_->on_can(f);
+    next_.on_can(f);
+  }
   void on_gps(const GpsFix& f) override { next_.on_gps(f); }
   void on_rtk(const GpsFix& f) override { next_.on_rtk(f); }
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& a) override { next_.on_actors(stamp_ns, a); }
@@ -250,6 +281,7 @@ class TruthTap : public StreamSink {
   StreamSink& next_;
   std::vector<TruthSample>& truth_;
   size_t& scans_;
+  DelayedPose* controller_pose_;
 };
 
 }  // namespace
@@ -260,17 +292,20 @@ LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<Loc
   LoopResult result;
   if (methods.empty()) return result;
   Localizers localizers(map, methods, result);
+  std::optional<DelayedPose> controller_pose;
+  if (closed_loop) controller_pose.emplace(methods.front());
+  const auto handed_out = [&](const LocalizerEstimate& e) {
+    if (controller_pose) controller_pose->on_estimate(e);
+    if (on_estimate) on_estimate(e);
+  };
   const auto t0 = Clock::now();
-  if (closed_loop) {
-    SerialSink sink(localizers, also, on_estimate);
-    TruthTap tap(sink, result.truth, result.scans);
-    sim.set_pose_source([&localizers](int64_t, const Pose2d& truth) { return localizers.primary().pose().value_or(truth); });
+  {
+    PipelinedSink sink(localizers, also, handed_out);
+    TruthTap tap(sink, result.truth, result.scans, controller_pose ? &*controller_pose : nullptr);
+    if (controller_pose)
+      sim.set_pose_source([&](int64_t t_ns, const Pose2d& truth) { return controller_pose->pose(t_ns, truth); });
     sim.run(tap, progress);
     sim.set_pose_source({});
-  } else {
-    PipelinedSink sink(localizers, also, on_estimate);
-    TruthTap tap(sink, result.truth, result.scans);
-    sim.run(tap, progress);
     sink.finish();
   }
   result.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();

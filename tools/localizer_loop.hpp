@@ -2,7 +2,7 @@
 // The simulator and the localizer in one loop: every CAN frame, GPS fix and scan the simulation emits
 // goes, in time order, to one or more localizers (one per method: `compare` feeds them all the same
 // stream), and each scan's estimate is kept with the ground truth for scoring. In closed loop the
-// first method's estimate is what the controller steers on.
+// first method's estimate is what the controller steers on (a scan late: see run_localizer_loop).
 #include <functional>
 #include <memory>
 #include <string>
@@ -37,8 +37,9 @@ struct LoopResult {
 };
 
 // Runs `sim` to its end. `also`: another sink that sees every stream too (a recorder), or null.
-// `progress` is called with the fraction done. Closed loop: the controller steers on the first
-// method's pose (its filter, predicted to the latest CAN frame) once that is initialised.
+// `progress` is called with the fraction done. The localizers run on a thread beside the simulation.
+// Closed loop: the controller steers on the first method's newest handed-out estimate (the previous
+// scan's) carried forward to the present by CAN odometry, once the localizer is initialised.
 // `on_estimate` sees the first method's every estimate as it is made (a recorder).
 LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<LocalizerParams>& methods,
                               bool closed_loop, StreamSink* also = nullptr,
