@@ -19,6 +19,11 @@ struct IntensityGridParams {
   int width_cells = 200;   // w_s: along x (forward)
   int height_cells = 200;  // h_s: along y (left)
   double cell_m = 0.2;
+  // Beyond the paper: only points this close to the ground plane go into S (m, either side). Points
+  // up to d_sigma = 0.5 m above it are not obstacles, but they are not road paint either: a car's
+  // sill, a coach's skirt and wheels. They move with the traffic, and a bright one riding beside the
+  // car matches a crosswalk stripe the same way scan after scan (it dragged APS 8 m in bus_occlusion).
+  double max_height = 0.15;
 };
 
 // Row-major, in the vehicle frame: x forward along the columns, y left along the rows, the vehicle at

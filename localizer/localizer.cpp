@@ -200,7 +200,7 @@ LocalizerEstimate Localizer::on_scan(const PointCloud& cloud) {
   const Pose2d prior = filter_->pose();
 
   // 2.1: the driving corridor, and the ground and obstacles inside it.
-  std::vector<size_t> ground;  // indices into points
+  std::vector<size_t> ground;  // indices into points: the road surface
   std::vector<Eigen::Vector2d> obstacles;
   if (removes_obstacles(method)) {
     const CorridorParams& cp = params_.corridor;
@@ -219,7 +219,9 @@ LocalizerEstimate Localizer::on_scan(const PointCloud& cloud) {
     e.stage_ms[size_t(Stage::corridor)] = watch.lap_ms();
     const ObstacleSplit split = reject_obstacles(inside_xyz, params_.obstacles);
     if (!split.plane_ok) e.health |= kNoGroundPlane;
-    for (size_t k : split.ground_index) ground.push_back(inside[k]);
+    for (size_t k : split.ground_index)  // the road surface, for S (see IntensityGridParams::max_height)
+      if (!split.plane_ok || distance_to_plane(split.plane, inside_xyz[k]) <= params_.intensity_grid.max_height)
+        ground.push_back(inside[k]);
     for (const auto& o : split.obstacles) obstacles.push_back(o.head<2>());
     e.obstacle_points = obstacles.size();
     e.stage_ms[size_t(Stage::obstacles)] = watch.lap_ms();

@@ -119,6 +119,8 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   Section(y, node["obstacles"], "obstacles")
       .number("ground_fraction", p.obstacles.ground_fraction, 0.01, 1.0)
       .number("obstacle_distance", p.obstacles.obstacle_distance, 0.01, 10.0)
+      .number("ground_cell_m", p.obstacles.ground_cell_m, 0.05, 20.0)
+      .number("ground_refit_distance", p.obstacles.ground_refit_distance, 0.01, 10.0)
       .done();
   top.section("curb_detector");
   Section(y, node["curb_detector"], "curb_detector")
@@ -181,6 +183,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .integer("width_cells", p.intensity_grid.width_cells, 10, 4000)
       .integer("height_cells", p.intensity_grid.height_cells, 10, 4000)
       .number("cell_m", p.intensity_grid.cell_m, 0.01, 2.0)
+      .number("max_height", p.intensity_grid.max_height, 0.01, 10.0)
       .done();
   top.section("aps");
   Section(y, node["aps"], "aps")

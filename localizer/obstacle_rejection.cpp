@@ -11,6 +11,49 @@ namespace {
 
 bool finite(const Eigen::Vector3d& p) { return p.allFinite(); }
 
+// Beyond this many cells the cells grow instead: a caller may pass points spread over kilometres.
+constexpr double kMaxGroundCells = 1 << 20;
+
+// The lowest of `points` (all finite) in each square cell of side `cell_m`, in cell order.
+std::vector<Eigen::Vector3d> lowest_per_cell(const std::vector<Eigen::Vector3d>& points, double cell_m) {
+  if (points.empty()) return {};
+  Eigen::Vector2d lo = points[0].head<2>(), hi = lo;
+  for (const auto& p : points) {
+    lo = lo.cwiseMin(p.head<2>());
+    hi = hi.cwiseMax(p.head<2>());
+  }
+  const Eigen::Vector2d extent = hi - lo;
+  const double cell = std::max(cell_m, std::sqrt((extent.x() + cell_m) * (extent.y() + cell_m) / kMaxGroundCells));
+  const size_t cols = size_t(extent.x() / cell) + 1, rows = size_t(extent.y() / cell) + 1;
+  std::vector<long> lowest(cols * rows, -1);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const size_t c = std::min(size_t((points[i].x() - lo.x()) / cell), cols - 1);
+    const size_t r = std::min(size_t((points[i].y() - lo.y()) / cell), rows - 1);
+    long& k = lowest[r * cols + c];
+    if (k < 0 || points[i].z() < points[size_t(k)].z()) k = long(i);
+  }
+  std::vector<Eigen::Vector3d> out;
+  for (long k : lowest)
+    if (k >= 0) out.push_back(points[size_t(k)]);
+  return out;
+}
+
+// The ground plane of reject_obstacles: Eq. 2 on the cells' lowest points, then again on every point
+// near that plane. The second fit matters: the lowest of a cell's noisy returns lies below the road by
+// about twice the range noise, so the first plane sits a few centimetres low. Too few cells for a plane
+// (a handful of points): Eq. 2 on the points themselves.
+std::optional<Plane> fit_ground(const std::vector<Eigen::Vector3d>& points, const ObstacleParams& params) {
+  const std::optional<Plane> first =
+      fit_ground_plane(lowest_per_cell(points, params.ground_cell_m), params.ground_fraction);
+  if (!first) return fit_ground_plane(points, params.ground_fraction);
+  std::vector<Eigen::Vector3d> near;
+  near.reserve(points.size());
+  for (const auto& p : points)
+    if (distance_to_plane(*first, p) <= params.ground_refit_distance) near.push_back(p);
+  const std::optional<Plane> refit = fit_ground_plane(std::move(near), 1.0);
+  return refit ? refit : first;
+}
+
 }  // namespace
 
 std::optional<Plane> fit_ground_plane(std::vector<Eigen::Vector3d> points, double fraction) {
@@ -77,7 +120,7 @@ ObstacleSplit reject_obstacles(const std::vector<Eigen::Vector3d>& corridor_poin
       index.push_back(i);
     }
 
-  const auto plane = fit_ground_plane(pts, params.ground_fraction);
+  const auto plane = fit_ground(pts, params);
   if (!plane) {
     out.ground = std::move(pts);
     out.ground_index = std::move(index);

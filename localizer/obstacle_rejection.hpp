@@ -16,6 +16,14 @@ struct ObstacleParams {
   // assumed to hold the obstacles, so they cannot drag the plane upwards.
   double ground_fraction = 0.95;
   double obstacle_distance = 0.5;  // d_sigma (m)
+  // Beyond the paper. Eq. 2 on the lowest xi % assumes obstacles make fewer than 1 - xi of the corridor
+  // points. A coach alongside is a wall of returns, far more than 5 %: the "lowest 95 %" climb its side
+  // and the plane tilts towards it (by 19 deg in bus_occlusion, so its flank counted as ground). The
+  // ground is the lowest surface, so the fit sees one point per cell of this size, the lowest return
+  // in it: a wall covers few cells however many returns it makes.
+  double ground_cell_m = 1.0;
+  // The plane is then fitted again to all points within this distance of the first one (m).
+  double ground_refit_distance = 0.2;
 };
 
 // z = a0 x + a1 y + a2 (Eq. 2), in the vehicle frame (z up).
@@ -42,7 +50,8 @@ struct ObstacleSplit {
 };
 
 // corridor_points: vehicle frame (z up), already inside the driving corridor. Non-finite points are
-// dropped first (in neither output). Obstacle = more than d_sigma from the plane (Eq. 3) AND above it.
+// dropped first (in neither output). The plane: Eq. 2 on the lowest xi % of the cells' lowest points,
+// refitted on all points near it (see ObstacleParams). Obstacle = more than d_sigma from the plane (Eq. 3) AND above it.
 // Eq. 3 uses |d|, but a point far below the road cannot be something the car drives into or something
 // that hides a curb: it is a reflection (wet road, glass; the mirrored return lands under the ground),
 // a dip beyond the fitted patch, or a ditch. Calling it an obstacle would only remove ground evidence.
