@@ -15,6 +15,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/crc32.hpp"
 #include "common/input_error.hpp"
 #include "common/yaml_reader.hpp"
 
@@ -52,31 +53,8 @@ constexpr const char* kTempSuffix = ".tmp";
 // physical distance.
 constexpr double kBoundarySnapUlps = 64;
 
-// CRC-32, IEEE 802.3 (reflected polynomial 0xEDB88320; zlib, PNG, gzip), table-driven.
-constexpr uint32_t kCrcPolynomial = 0xEDB88320u;
-constexpr uint32_t kCrcInitial = 0xFFFFFFFFu;
-constexpr uint32_t kCrcFinalXor = 0xFFFFFFFFu;
 constexpr size_t kBitsPerByte = 8;
-constexpr size_t kByteValues = 256;
 constexpr uint32_t kLowByte = 0xFFu;
-
-constexpr std::array<uint32_t, kByteValues> make_crc_table() {
-  std::array<uint32_t, kByteValues> table{};
-  for (uint32_t n = 0; n < kByteValues; ++n) {
-    uint32_t c = n;
-    for (size_t bit = 0; bit < kBitsPerByte; ++bit) c = (c & 1u) ? kCrcPolynomial ^ (c >> 1) : c >> 1;
-    table[n] = c;
-  }
-  return table;
-}
-constexpr std::array<uint32_t, kByteValues> kCrcTable = make_crc_table();
-
-uint32_t crc32(const std::string& bytes, size_t length) {
-  uint32_t c = kCrcInitial;
-  for (size_t i = 0; i < length; ++i)
-    c = kCrcTable[(c ^ static_cast<unsigned char>(bytes[i])) & kLowByte] ^ (c >> kBitsPerByte);
-  return c ^ kCrcFinalXor;
-}
 
 // Explicit little-endian bytes, so files are the same on any host.
 void put_u32(std::string& out, uint32_t v) {
@@ -180,7 +158,7 @@ std::string encode_tile(int tx, int ty, int tile_cells, const std::vector<Intens
     put_f32(out, c.mean);
     put_f32(out, c.m2);
   }
-  put_u32(out, crc32(out, out.size()));
+  put_u32(out, crc32(out.data(), out.size()));
   return out;
 }
 
@@ -237,9 +215,8 @@ std::vector<IntensityCell> load_tile(const fs::path& path, const IntensityMapHea
   {
     std::ifstream in(path, std::ios::binary);
     if (!in.is_open()) throw InputError(file + ": cannot open tile file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    bytes = text.str();
+    bytes.resize(size_t(fs::file_size(path, ec)));
+    if (ec || !in.read(bytes.data(), std::streamsize(bytes.size()))) throw InputError(file + ": cannot read tile file");
   }
   const size_t expected = tile_file_bytes(size_t(h.tile_cells));
   auto truncated = [&] {
@@ -270,7 +247,7 @@ std::vector<IntensityCell> load_tile(const fs::path& path, const IntensityMapHea
     throw InputError(file + ": tile file has " + std::to_string(bytes.size() - expected) +
                      " unexpected bytes after its checksum");
   const uint32_t stored_crc = get_u32(bytes, expected - kCrcBytes);
-  const uint32_t computed_crc = crc32(bytes, expected - kCrcBytes);
+  const uint32_t computed_crc = crc32(bytes.data(), expected - kCrcBytes);
   if (stored_crc != computed_crc) {
     std::ostringstream msg;
     msg << file << ": checksum mismatch (CRC-32 stored 0x" << std::hex << stored_crc << ", computed 0x"

@@ -12,7 +12,7 @@
 #include "common/input_error.hpp"
 #include "mcap_fixture.hpp"
 #include "tools/mcap/cdr.hpp"
-#include "tools/mcap/crc32.hpp"
+#include "common/crc32.hpp"
 #include "tools/mcap/log_export.hpp"
 #include "tools/mcap/log_topics.hpp"
 #include "tools/mcap/mcap_reader.hpp"

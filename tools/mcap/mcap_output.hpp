@@ -20,7 +20,7 @@
 #include <utility>
 #include <vector>
 
-#include "tools/mcap/crc32.hpp"
+#include "common/crc32.hpp"
 #include "tools/mcap/mcap_records.hpp"
 #include "tools/mcap/zstd_codec.hpp"
 

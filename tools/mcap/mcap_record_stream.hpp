@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/mcap/crc32.hpp"
+#include "common/crc32.hpp"
 
 namespace lidarloop {
 

@@ -1,6 +1,6 @@
 #include "tools/mcap/mcap_records.hpp"
 
-#include "tools/mcap/crc32.hpp"
+#include "common/crc32.hpp"
 
 namespace lidarloop::mcap {
 

@@ -1,7 +1,8 @@
 #pragma once
-// CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320): the checksum MCAP uses for chunks,
-// attachments, the data section and the summary. Slicing-by-8, since every byte of a log passes
-// through it twice (chunk records, then the data section).
+// CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320; zlib, PNG, gzip): the checksum of intensity
+// map tiles and the one MCAP uses for chunks, attachments, the data section and the summary.
+// Slicing-by-8: every byte of a log passes through it twice (chunk records, then the data section),
+// and a tile (1.2 MB) is checked when the car drives into it, inside a scan's time budget.
 #include <cstddef>
 #include <cstdint>
 

@@ -1,4 +1,4 @@
-#include "tools/mcap/crc32.hpp"
+#include "common/crc32.hpp"
 
 #include <array>
 
