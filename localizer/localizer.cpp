@@ -83,12 +83,8 @@ void Localizer::predict_to(int64_t t_ns) {
   if (t_ns <= time_ns_) return;
   const Pose2d before = odometry_;
   const double dt = double(t_ns - time_ns_) / kNsPerS;
-  const int64_t max_step_ns = std::max<int64_t>(1, int64_t(params_.max_prediction_step_s * kNsPerS));
-  while (time_ns_ < t_ns) {
-    const int64_t h = std::min(max_step_ns, t_ns - time_ns_);
-    odometry_ = predictor_.predict(odometry_, speed_, steer_, double(h) / kNsPerS);  // Eq. 19 (Euler)
-    time_ns_ += h;
-  }
+  odometry_ = predictor_.advance(odometry_, speed_, steer_, t_ns - time_ns_, params_.max_prediction_step_s);
+  time_ns_ = t_ns;
   if (!filter_) return;
   // The filter moves by the odometry's increment in its own frame.
   const Odometry2d step = relative(before, odometry_);

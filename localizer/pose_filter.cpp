@@ -9,6 +9,17 @@ namespace lidarloop {
 
 constexpr double kTyresPerAxle = 2;  // Eq. 19's factor 2: the stiffness is per tyre
 
+Pose2d MotionPredictor::advance(Pose2d pose, double v, double delta, int64_t dt_ns, double max_step_s) {
+  constexpr double kNsPerS = 1e9;
+  const int64_t max_step_ns = std::max<int64_t>(1, int64_t(max_step_s * kNsPerS));
+  for (int64_t done = 0; done < dt_ns;) {
+    const int64_t h = std::min(max_step_ns, dt_ns - done);
+    pose = predict(pose, v, delta, double(h) / kNsPerS);  // Eq. 19 (Euler)
+    done += h;
+  }
+  return pose;
+}
+
 Pose2d MotionPredictor::predict(const Pose2d& pose, double v, double delta, double dt) {
   const double L = p_.lf + p_.lr;
   v = std::max(0.0, v);

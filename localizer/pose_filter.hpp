@@ -29,6 +29,8 @@ class MotionPredictor {
   explicit MotionPredictor(const VehicleModelParams& params) : p_(params) {}
   // Advances the pose (rear axle, local frame) by dt with speed v and front wheel angle delta.
   Pose2d predict(const Pose2d& pose, double v, double delta, double dt);
+  // The same over dt_ns, in Euler steps of at most max_step_s, v and delta held throughout.
+  Pose2d advance(Pose2d pose, double v, double delta, int64_t dt_ns, double max_step_s);
   double yaw_rate() const { return yaw_rate_; }  // rad/s, as of the last step
 
  private:

@@ -1,13 +1,13 @@
 #include "tools/localizer_loop.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <exception>
-#include <algorithm>
-#include <optional>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <variant>
 
@@ -237,12 +237,10 @@ class DelayedPose {
   };
   // `o` driven on to t_ns in the localizer's Euler steps.
   Odometry advanced(Odometry o, int64_t t_ns) const {
-    const int64_t max_step = std::max<int64_t>(1, int64_t(params_.max_prediction_step_s * 1e9));
-    while (o.stamp_ns < t_ns) {
-      const int64_t h = std::min(max_step, t_ns - o.stamp_ns);
-      o.pose = o.predictor.predict(o.pose, o.motion.speed, o.motion.steer, double(h) * 1e-9);
-      o.stamp_ns += h;
-    }
+    if (t_ns <= o.stamp_ns) return o;
+    o.pose = o.predictor.advance(o.pose, o.motion.speed, o.motion.steer, t_ns - o.stamp_ns,
+                                 params_.max_prediction_step_s);
+    o.stamp_ns = t_ns;
     return o;
   }
   Pose2d odometry_at(int64_t t_ns) const {
@@ -256,10 +254,11 @@ class DelayedPose {
   std::optional<Stamped> estimate_;
 };
 
-// The scorer wants the truth too; it is collected in the simulation thread, before either sink.
-class TruthTap : public StreamSink {
+// What the simulation thread itself takes from the streams before the localizers' sink: the truth for
+// the scorer, the scan count, and the CAN frames the controller's dead reckoning needs.
+class SimulationTap : public StreamSink {
  public:
-  TruthTap(StreamSink& next, std::vector<TruthSample>& truth, size_t& scans, DelayedPose* controller_pose)
+  SimulationTap(StreamSink& next, std::vector<TruthSample>& truth, size_t& scans, DelayedPose* controller_pose)
       : next_(next), truth_(truth), scans_(scans), controller_pose_(controller_pose) {}
   void on_truth(const TruthSample& t) override {
     truth_.push_back(t);
@@ -301,7 +300,7 @@ LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<Loc
   const auto t0 = Clock::now();
   {
     PipelinedSink sink(localizers, also, handed_out);
-    TruthTap tap(sink, result.truth, result.scans, controller_pose ? &*controller_pose : nullptr);
+    SimulationTap tap(sink, result.truth, result.scans, controller_pose ? &*controller_pose : nullptr);
     if (controller_pose)
       sim.set_pose_source([&](int64_t t_ns, const Pose2d& truth) { return controller_pose->pose(t_ns, truth); });
     sim.run(tap, progress);
