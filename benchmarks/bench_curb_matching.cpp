@@ -79,7 +79,7 @@ BENCHMARK(BM_BuildIndex);
 void BM_ProbabilisticIcp(benchmark::State& state) {
   const MapIndex index(city_blocks());
   // A scan's curbs seen from a pose 0.5 m and 1 deg off.
-  const Transform2d error{0.5, -0.3, 0.0175};
+  const Pose2d error{0.5, -0.3, 0.0175};
   std::vector<Eigen::Vector2d> curbs;
   for (const auto& q : detections(index.points(), kScanCurbs, 2)) curbs.push_back(error.inverse().apply(q));
   const ProbabilisticIcpParams params;

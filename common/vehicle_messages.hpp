@@ -4,17 +4,9 @@
 #include <array>
 #include <cstdint>
 
+#include "common/pose2d.hpp"
+
 namespace lidarloop {
-
-// A planar pose in the local frame: x east, y north (m), yaw counter-clockwise from +x (rad).
-struct Pose2d {
-  double x = 0, y = 0, yaw = 0;
-};
-
-struct PoseStamped {
-  int64_t stamp_ns = 0;
-  Pose2d pose;
-};
 
 // One vehicle report from the CAN bus (layout in assets/vehicle_can.dbc).
 struct CanFrame {
@@ -32,6 +24,16 @@ struct GpsFix {
   double heading_rad = 0;                        // yaw in the local frame (from +x east, counter-clockwise)
   std::array<double, 9> position_covariance{};   // m^2, east-north-up, row major (as NavSatFix)
   double heading_variance = 0;                   // rad^2
+};
+
+// The ground truth of the vehicle's state, as a simulator or an RTK/INS reference system gives it.
+struct TruthSample {
+  int64_t stamp_ns = 0;
+  Pose2d pose;             // rear axle centre (the vehicle frame origin)
+  double speed = 0;        // m/s
+  double yaw_rate = 0;     // rad/s
+  double steer = 0;        // front wheel angle, rad
+  double cross_track = 0;  // the driver's lateral error to its route, m
 };
 
 }  // namespace lidarloop

@@ -11,27 +11,16 @@
 
 namespace lidarloop {
 
-Odometry2d relative(const Pose2d& a, const Pose2d& b) {
-  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
-  const double dx = b.x - a.x, dy = b.y - a.y;
-  return {c * dx + s * dy, -s * dx + c * dy, wrap_angle(b.yaw - a.yaw)};
-}
-
-Pose2d compose(const Pose2d& a, const Odometry2d& d) {
-  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
-  return {a.x + c * d.dx - s * d.dy, a.y + s * d.dx + c * d.dy, wrap_angle(a.yaw + d.dpsi)};
-}
-
-std::vector<Eigen::Vector2d> to_current_frame(const std::vector<Eigen::Vector2d>& previous, const Odometry2d& m) {
-  const Eigen::Rotation2D<double> back(-m.dpsi);
-  const Eigen::Vector2d d(m.dx, m.dy);
+std::vector<Eigen::Vector2d> to_current_frame(const std::vector<Eigen::Vector2d>& previous, const Pose2d& m) {
+  const Eigen::Rotation2D<double> back(-m.yaw);
+  const Eigen::Vector2d d(m.x, m.y);
   std::vector<Eigen::Vector2d> out;
   out.reserve(previous.size());
   for (const auto& c : previous) out.push_back(back * (c - d));
   return out;
 }
 
-void CurbAccumulator::add(const std::vector<Eigen::Vector2d>& curbs, const Odometry2d& motion) {
+void CurbAccumulator::add(const std::vector<Eigen::Vector2d>& curbs, const Pose2d& motion) {
   for (auto& frame : history_) frame = to_current_frame(frame, motion);
   const std::vector<Eigen::Vector2d> moved =
       to_current_frame(std::vector<Eigen::Vector2d>(origins_.begin(), origins_.end()), motion);

@@ -18,27 +18,18 @@ struct CurbFeatureParams {
   double beam_half_extent = 25.0;  // m: the +-25 m box of Eq. 6
 };
 
-// The vehicle's motion since the previous frame, expressed in the previous vehicle frame: it moved by
-// (dx, dy) and turned by dpsi (counter-clockwise).
-struct Odometry2d {
-  double dx = 0, dy = 0, dpsi = 0;
-};
-
-// b's pose relative to a, in a's frame: the motion from a to b.
-Odometry2d relative(const Pose2d& a, const Pose2d& b);
-// a moved by d (d in a's frame).
-Pose2d compose(const Pose2d& a, const Odometry2d& d);
-
-// Eq. 5: where points of the previous vehicle frame are in the current one: R(-dpsi) (C - d). (The
-// paper prints R(dpsi); with dpsi the vehicle's own turn, the points turn the other way.)
-std::vector<Eigen::Vector2d> to_current_frame(const std::vector<Eigen::Vector2d>& previous, const Odometry2d& motion);
+// Eq. 5: where points of the previous vehicle frame are in the current one: R(-dpsi) (C - d), with
+// `motion` = (d, dpsi) the vehicle's motion since the previous frame, in the previous vehicle frame
+// (relative(previous pose, current pose)). The paper prints R(dpsi); with dpsi the vehicle's own turn,
+// the points turn the other way.
+std::vector<Eigen::Vector2d> to_current_frame(const std::vector<Eigen::Vector2d>& previous, const Pose2d& motion);
 
 // Eq. 4: the last `frames` frames of curbs, kept in the current vehicle frame, with the positions the
 // vehicle had at each of them (the launching points of the beam model).
 class CurbAccumulator {
  public:
   explicit CurbAccumulator(int frames) : frames_(frames) {}
-  void add(const std::vector<Eigen::Vector2d>& curbs, const Odometry2d& motion_since_previous);
+  void add(const std::vector<Eigen::Vector2d>& curbs, const Pose2d& motion_since_previous);
   std::vector<Eigen::Vector2d> curbs() const;
   const std::deque<Eigen::Vector2d>& launch_points() const { return origins_; }
 

@@ -165,7 +165,7 @@ FmtResult fmt_match(const std::vector<Eigen::Vector2d>& curbs_world, const std::
   const double c = std::cos(best_rotation), s = std::sin(best_rotation);
   const Eigen::Vector2d turned_centre(c * centre.x() - s * centre.y(), s * centre.x() + c * centre.y());
   const Eigen::Vector2d offset = centre - turned_centre + t;
-  result.correction = Transform2d{offset.x(), offset.y(), best_rotation};
+  result.correction = Pose2d{offset.x(), offset.y(), best_rotation};
   result.ok = true;
   return result;
 }

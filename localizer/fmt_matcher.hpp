@@ -13,7 +13,7 @@
 
 #include <Eigen/Core>
 
-#include "localizer/probabilistic_icp.hpp"  // Transform2d
+#include "common/pose2d.hpp"
 
 namespace lidarloop {
 
@@ -58,7 +58,7 @@ struct FmtResult {
   bool ok = false;  // false: too few points, or the translation peak below min_response
   // Maps the curbs (placed in the world at the prior pose) onto the map: the same meaning as
   // IcpResult::t, so the corrected pose is correction applied to the prior pose. Identity when !ok.
-  Transform2d correction;
+  Pose2d correction;
   double response = 0;  // phaseCorrelate peak response of the translation step (0 when not computed)
 };
 

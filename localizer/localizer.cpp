@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include "common/units.hpp"
 #include "localizer/aps_matcher.hpp"
 #include "localizer/curb_detector.hpp"
 #include "localizer/curb_match_covariance.hpp"
@@ -16,7 +17,6 @@
 namespace lidarloop {
 namespace {
 
-constexpr double kNsPerS = 1e9;
 // Before the first fix there is no pose: the estimate says so with this (m^2, rad^2) on the diagonal.
 constexpr double kUnknownVariance = 1e6;
 
@@ -87,8 +87,8 @@ void Localizer::predict_to(int64_t t_ns) {
   time_ns_ = t_ns;
   if (!filter_) return;
   // The filter moves by the odometry's increment in its own frame.
-  const Odometry2d step = relative(before, odometry_);
-  filter_->predict(compose(filter_->pose(), step), std::hypot(step.dx, step.dy), dt);
+  const Pose2d step = relative(before, odometry_);
+  filter_->predict(filter_->pose().compose(step), std::hypot(step.x, step.y), dt);
   const bool can_stale =
       !last_can_ns_ || double(t_ns - *last_can_ns_) / kNsPerS > params_.health.can_timeout_s;
   if (can_stale) {
@@ -162,8 +162,8 @@ LocalizerEstimate Localizer::on_scan(const PointCloud& cloud) {
   e.stamp_ns = std::max(cloud.stamp_ns + int64_t(last_t), time_ns_);
   predict_to(e.stamp_ns);
   e.health = input_health(e.stamp_ns);
-  const Odometry2d since_previous =
-      previous_scan_odometry_ ? relative(*previous_scan_odometry_, odometry_) : Odometry2d{};
+  const Pose2d since_previous =
+      previous_scan_odometry_ ? relative(*previous_scan_odometry_, odometry_) : Pose2d{};
   previous_scan_odometry_ = odometry_;
   features_ = {};
 
@@ -281,7 +281,7 @@ void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, Locali
     local_tangents.push_back(map_.curbs.tangents()[i]);
   }
   const MapIndex local_map(local_points);
-  Transform2d t;
+  Pose2d t;
   switch (params_.method) {
     case LocalizerMethod::proposed: {
       ProbabilisticIcpParams p = params_.probabilistic_icp;
@@ -313,7 +313,7 @@ void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, Locali
       return;
   }
   const Eigen::Vector2d corrected_xy = t.apply(xy(prior));
-  const Pose2d z{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t.theta)};
+  const Pose2d z{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t.yaw)};
   const CurbMatchQuality q = curb_match_quality(features, z, local_map, local_tangents, params_.curb_noise);
   e.curb_observation = z;
   e.curb_inlier_ratio = q.inlier_ratio;

@@ -62,22 +62,6 @@ void read_icp(const YamlReader& y, const YAML::Node& n, const char* name, IcpPar
 
 }  // namespace
 
-const std::vector<std::string>& localizer_method_names() {
-  static const std::vector<std::string> names = {"gps", "icp", "icp-obs", "m-icp", "fmt", "intensity", "proposed"};
-  return names;
-}
-
-std::string method_name(LocalizerMethod m) { return localizer_method_names()[size_t(m)]; }
-
-LocalizerMethod parse_localizer_method(const std::string& name) {
-  const auto& names = localizer_method_names();
-  for (size_t i = 0; i < names.size(); ++i)
-    if (names[i] == name) return LocalizerMethod(i);
-  std::string list;
-  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-  throw std::invalid_argument("unknown localizer method '" + name + "' (expected one of: " + list + ")");
-}
-
 bool uses_curbs(LocalizerMethod m) {
   return m == LocalizerMethod::icp || m == LocalizerMethod::icp_obs || m == LocalizerMethod::m_icp ||
          m == LocalizerMethod::fmt || m == LocalizerMethod::proposed;

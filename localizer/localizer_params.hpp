@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/localizer_method.hpp"
 #include "common/yaml_reader.hpp"
 #include "localizer/aps_matcher.hpp"
 #include "localizer/curb_detector.hpp"
@@ -20,22 +21,6 @@
 #include "localizer/probabilistic_icp.hpp"
 
 namespace lidarloop {
-
-// The paper's method and the baselines of its Tables II and III. Every method runs in the same
-// filter (prediction from CAN, KF1 with GPS); they differ in the map-matching observations of KF2:
-//   gps        none
-//   icp        plain ICP on the curb features, no obstacle removal (corridor, plane, d_o all off)
-//   icp-obs    plain ICP on curb features after obstacle removal
-//   m-icp      biweight M-ICP (Eq. 21-22) after obstacle removal
-//   fmt        Fourier-Mellin on curb grid images after obstacle removal
-//   intensity  APS on the intensity layer only
-//   proposed   probabilistic ICP after obstacle removal, and APS
-enum class LocalizerMethod { gps, icp, icp_obs, m_icp, fmt, intensity, proposed };
-
-const std::vector<std::string>& localizer_method_names();
-std::string method_name(LocalizerMethod m);
-// Throws std::invalid_argument listing the valid names.
-LocalizerMethod parse_localizer_method(const std::string& name);
 
 bool uses_curbs(LocalizerMethod m);
 bool uses_intensity(LocalizerMethod m);

@@ -1,4 +1,5 @@
 #include "localizer/pose_filter.hpp"
+#include "common/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,6 @@ namespace lidarloop {
 constexpr double kTyresPerAxle = 2;  // Eq. 19's factor 2: the stiffness is per tyre
 
 Pose2d MotionPredictor::advance(Pose2d pose, double v, double delta, int64_t dt_ns, double max_step_s) {
-  constexpr double kNsPerS = 1e9;
   const int64_t max_step_ns = std::max<int64_t>(1, int64_t(max_step_s * kNsPerS));
   for (int64_t done = 0; done < dt_ns;) {
     const int64_t h = std::min(max_step_ns, dt_ns - done);
@@ -42,7 +42,7 @@ Pose2d MotionPredictor::predict(const Pose2d& pose, double v, double delta, doub
   const double lateral = v < p_.kinematic_below ? 0.0 : v * std::tan(beta_) - p_.lr * yaw_rate_;
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
   return {pose.x + (v * c - lateral * s) * dt, pose.y + (v * s + lateral * c) * dt,
-          std::remainder(pose.yaw + yaw_rate_ * dt, 2 * M_PI)};
+          wrap_angle(pose.yaw + yaw_rate_ * dt)};
 }
 
 PoseFilter::PoseFilter(const Pose2d& initial, const Eigen::Matrix3d& covariance, const PoseFilterParams& params)
@@ -66,11 +66,11 @@ template <int N>
 void PoseFilter::update(const Eigen::Matrix<double, N, 1>& z, const Eigen::Matrix<double, N, N>& R,
                         const Eigen::Matrix<double, N, 3>& H) {
   Eigen::Matrix<double, N, 1> innovation = z - H * x_;
-  if constexpr (N == 3) innovation(2) = std::remainder(innovation(2), 2 * M_PI);  // angles as angles
+  if constexpr (N == 3) innovation(2) = wrap_angle(innovation(2));  // angles as angles
   const Eigen::Matrix<double, N, N> S = H * P_ * H.transpose() + R;
   const Eigen::Matrix<double, 3, N> K = P_ * H.transpose() * S.inverse();
   x_ += K * innovation;
-  x_(2) = std::remainder(x_(2), 2 * M_PI);
+  x_(2) = wrap_angle(x_(2));
   // Joseph form: stays symmetric and positive definite whatever the rounding.
   const Eigen::Matrix3d I_KH = Eigen::Matrix3d::Identity() - K * H;
   P_ = I_KH * P_ * I_KH.transpose() + K * R * K.transpose();

@@ -8,155 +8,12 @@
 #include <numeric>
 #include <stdexcept>
 
-#include <nanoflann.hpp>
-
 namespace lidarloop {
-
-Eigen::Vector2d Transform2d::apply(const Eigen::Vector2d& p) const {
-  const double c = std::cos(theta), s = std::sin(theta);
-  return {c * p.x() - s * p.y() + x, s * p.x() + c * p.y() + y};
-}
-
-Transform2d Transform2d::compose(const Transform2d& b) const {
-  const Eigen::Vector2d t = apply({b.x, b.y});
-  return {t.x(), t.y(), wrap_angle(theta + b.theta)};
-}
-
-Transform2d Transform2d::inverse() const {
-  const double c = std::cos(theta), s = std::sin(theta);
-  // R^T (p - t): the translation is -R^T t.
-  return {-(c * x + s * y), -(-s * x + c * y), wrap_angle(-theta)};
-}
-
-double wrap_angle(double a) {
-  a = std::remainder(a, 2 * std::numbers::pi);  // [-pi, pi]
-  return a <= -std::numbers::pi ? a + 2 * std::numbers::pi : a;
-}
-
-// ---------------------------------------------------------------------------------------------------
-// MapIndex
-
-namespace {
-struct PointsAdaptor {
-  const std::vector<Eigen::Vector2d>* points;
-  size_t kdtree_get_point_count() const { return points->size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][int(dim)]; }
-  template <class BBox> bool kdtree_get_bbox(BBox&) const { return false; }
-};
-constexpr int kLeafSize = 16;  // nanoflann's usual trade-off between tree depth and leaf scans
-}  // namespace
-
-struct MapIndex::Tree {
-  PointsAdaptor adaptor;
-  nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor, 2> tree;
-  explicit Tree(const std::vector<Eigen::Vector2d>* points)
-      : adaptor{points}, tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize)) {
-    tree.buildIndex();
-  }
-};
-
-namespace {
-// Beyond this many buckets per point (a small window of a large map is the usual case, but a caller
-// may index a whole city), buckets grow instead: the answer stays exact, the memory bounded.
-constexpr double kMaxBucketsPerPoint = 4.0;
-constexpr double kMinBucketBudget = 4096;
-}  // namespace
-
-MapIndex::MapIndex(std::vector<Eigen::Vector2d> points, double bucket_m) : points_(std::move(points)) {
-  if (!(bucket_m > 0) || !std::isfinite(bucket_m))
-    throw std::invalid_argument("MapIndex: bucket size must be a positive number");
-  for (const auto& p : points_)
-    if (!p.allFinite()) throw std::invalid_argument("MapIndex: map points must be finite");
-  // nanoflann cannot build over zero points; an empty map answers every query with "nothing".
-  if (points_.empty()) return;
-  tree_ = std::make_unique<Tree>(&points_);
-
-  Buckets& b = buckets_;
-  Eigen::Vector2d lo = points_[0], hi = points_[0];
-  for (const auto& p : points_) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const Eigen::Vector2d extent = hi - lo;
-  const double budget = std::max(kMinBucketBudget, kMaxBucketsPerPoint * double(points_.size()));
-  b.size = std::max(bucket_m, std::sqrt((extent.x() + bucket_m) * (extent.y() + bucket_m) / budget));
-  b.origin = lo;
-  b.cols = int(extent.x() / b.size) + 1;
-  b.rows = int(extent.y() / b.size) + 1;
-  auto bucket_of = [&](const Eigen::Vector2d& p) {
-    const int c = std::min(int((p.x() - lo.x()) / b.size), b.cols - 1);
-    const int r = std::min(int((p.y() - lo.y()) / b.size), b.rows - 1);
-    return size_t(r) * size_t(b.cols) + size_t(c);
-  };
-  // Counting sort by bucket, stable, so equal buckets keep the points' order.
-  b.start.assign(size_t(b.cols) * size_t(b.rows) + 1, 0);
-  for (const auto& p : points_) ++b.start[bucket_of(p) + 1];
-  for (size_t k = 1; k < b.start.size(); ++k) b.start[k] += b.start[k - 1];
-  std::vector<uint32_t> fill(b.start.begin(), b.start.end() - 1);
-  b.sorted.resize(points_.size());
-  b.index.resize(points_.size());
-  for (size_t i = 0; i < points_.size(); ++i) {
-    const uint32_t slot = fill[bucket_of(points_[i])]++;
-    b.sorted[slot] = points_[i];
-    b.index[slot] = uint32_t(i);
-  }
-}
-MapIndex::~MapIndex() = default;
-// The tree reads the points through a pointer to the member vector: re-aim it after a move.
-MapIndex::MapIndex(MapIndex&& other) noexcept
-    : points_(std::move(other.points_)), tree_(std::move(other.tree_)), buckets_(std::move(other.buckets_)) {
-  if (tree_) tree_->adaptor.points = &points_;
-}
-MapIndex& MapIndex::operator=(MapIndex&& other) noexcept {
-  points_ = std::move(other.points_);
-  tree_ = std::move(other.tree_);
-  buckets_ = std::move(other.buckets_);
-  if (tree_) tree_->adaptor.points = &points_;
-  return *this;
-}
-
-std::pair<size_t, double> MapIndex::nearest(const Eigen::Vector2d& p) const {
-  if (!tree_) return {SIZE_MAX, std::numeric_limits<double>::infinity()};
-  uint32_t index = 0;
-  double squared = 0;
-  const double query[2] = {p.x(), p.y()};
-  tree_->tree.knnSearch(query, 1, &index, &squared);
-  return {size_t(index), std::sqrt(squared)};
-}
-
-std::pair<size_t, double> MapIndex::nearest_within(const Eigen::Vector2d& p, double radius) const {
-  constexpr std::pair<size_t, double> none{SIZE_MAX, std::numeric_limits<double>::infinity()};
-  if (!tree_ || !p.allFinite() || !(radius >= 0)) return none;
-  const Buckets& b = buckets_;
-  if (radius > b.size) {  // the circle reaches past the neighbouring buckets: the tree is cheaper
-    const auto found = nearest(p);
-    return found.second <= radius ? found : none;
-  }
-  // The 3 x 3 buckets around p hold every point within one bucket size of it. The range is clamped in
-  // double, so a query far off the map cannot overflow an int.
-  const double fc = std::floor((p.x() - b.origin.x()) / b.size), fr = std::floor((p.y() - b.origin.y()) / b.size);
-  const double c0 = std::max(fc - 1, 0.0), c1 = std::min(fc + 1, double(b.cols - 1));
-  const double r0 = std::max(fr - 1, 0.0), r1 = std::min(fr + 1, double(b.rows - 1));
-  if (c0 > c1 || r0 > r1) return none;
-  double best_squared = radius * radius;
-  size_t best = SIZE_MAX;
-  for (int r = int(r0); r <= int(r1); ++r) {
-    const size_t row = size_t(r) * size_t(b.cols);
-    for (uint32_t i = b.start[row + size_t(c0)], end = b.start[row + size_t(c1) + 1]; i < end; ++i) {
-      const double d = (b.sorted[i] - p).squaredNorm();
-      if (d < best_squared || (d == best_squared && b.index[i] < best)) {
-        best_squared = d;
-        best = b.index[i];
-      }
-    }
-  }
-  return best == SIZE_MAX ? none : std::pair<size_t, double>{best, std::sqrt(best_squared)};
-}
 
 // ---------------------------------------------------------------------------------------------------
 // The SVD step
 
-Transform2d fit_rigid_2d(const std::vector<Eigen::Vector2d>& src, const std::vector<Eigen::Vector2d>& dst,
+Pose2d fit_rigid_2d(const std::vector<Eigen::Vector2d>& src, const std::vector<Eigen::Vector2d>& dst,
                          const std::vector<double>* weights) {
   if (src.size() != dst.size() || (weights && weights->size() != src.size()))
     throw std::invalid_argument("fit_rigid_2d: src, dst and weights must have the same size");
@@ -180,7 +37,7 @@ Transform2d fit_rigid_2d(const std::vector<Eigen::Vector2d>& src, const std::vec
     dot += w * (s.x() * d.x() + s.y() * d.y());
     cross += w * (s.x() * d.y() - s.y() * d.x());
   }
-  Transform2d t{0, 0, std::atan2(cross, dot)};  // a single pair: atan2(0, 0) = 0, translation only
+  Pose2d t{0, 0, std::atan2(cross, dot)};  // a single pair: atan2(0, 0) = 0, translation only
   const Eigen::Vector2d rotated = t.apply(cs);
   t.x = cd.x() - rotated.x();
   t.y = cd.y() - rotated.y();
@@ -212,7 +69,7 @@ void score(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, doubl
 
 // `gate`: no correspondence beyond it; the weight function may still drop nearer ones.
 template <class WeightFn>
-IcpResult run_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Transform2d initial,
+IcpResult run_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial,
                   const IcpParams& params, double gate, WeightFn weight) {
   IcpResult result;
   result.t = initial;
@@ -239,10 +96,10 @@ IcpResult run_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs
     }
     if (src.empty()) break;  // nothing to pull on: keep the current transform
     // Eq. 9 minimised for fixed correspondences; the increment is applied on top of the current pose.
-    const Transform2d delta = fit_rigid_2d(src, dst, &w);
+    const Pose2d delta = fit_rigid_2d(src, dst, &w);
     result.t = delta.compose(result.t);
     ++result.iterations;
-    if (std::hypot(delta.x, delta.y) < params.convergence && std::abs(delta.theta) < params.convergence) break;
+    if (std::hypot(delta.x, delta.y) < params.convergence && std::abs(delta.yaw) < params.convergence) break;
   }
   score(map, curbs, gate, weight, result);
   return result;
@@ -262,14 +119,14 @@ size_t draw_below(std::mt19937_64& rng, size_t n) {
 
 }  // namespace
 
-IcpResult icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Transform2d initial,
+IcpResult icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial,
               const IcpParams& params, double reject_distance) {
   // Eq. 12: a curb farther than reject_distance from the map is an outlier and takes no part in the fit.
   const double gate = std::min(params.max_correspondence, reject_distance);
   return run_icp(map, curbs, initial, params, gate, [](double) { return 1.0; });
 }
 
-IcpResult m_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Transform2d initial,
+IcpResult m_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial,
                 const MIcpParams& params) {
   const double b = params.biweight_b, scale = params.scale_m;
   // IRLS weight of Eq. 22: rho'(u)/u = (1 - (u/B)^2)^2 inside B, 0 outside (rho is flat there).
@@ -285,7 +142,7 @@ IcpResult m_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, 
 // ---------------------------------------------------------------------------------------------------
 // Probabilistic ICP
 
-Transform2d fuse_hypotheses(const std::vector<IcpHypothesis>& hypotheses, double outlier_temperature) {
+Pose2d fuse_hypotheses(const std::vector<IcpHypothesis>& hypotheses, double outlier_temperature) {
   if (hypotheses.empty()) return {};
   double best = 1.0;
   for (const auto& h : hypotheses) best = std::min(best, h.outlier_ratio);
@@ -298,14 +155,14 @@ Transform2d fuse_hypotheses(const std::vector<IcpHypothesis>& hypotheses, double
     x += w * h.t.x;
     y += w * h.t.y;
     // Angles are averaged as unit vectors so that +179 and -179 deg average to 180, not 0.
-    s += w * std::sin(h.t.theta);
-    c += w * std::cos(h.t.theta);
+    s += w * std::sin(h.t.yaw);
+    c += w * std::cos(h.t.yaw);
   }
   return {x / total, y / total, std::atan2(s, c)};
 }
 
 IcpResult probabilistic_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs,
-                            Transform2d initial, const ProbabilisticIcpParams& params, std::mt19937_64& rng) {
+                            Pose2d initial, const ProbabilisticIcpParams& params, std::mt19937_64& rng) {
   IcpResult result;
   result.t = initial;
   if (curbs.empty() || map.empty()) return result;

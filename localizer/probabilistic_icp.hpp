@@ -9,77 +9,22 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
-#include <memory>
 #include <random>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "common/pose2d.hpp"
+#include "localizer/map_index.hpp"
+
 namespace lidarloop {
-
-// A 2-D rigid transform p -> R(theta) p + (x, y). It maps detected curbs (vehicle frame as estimated)
-// onto the map, so the fitted transform is the correction to the pose estimate.
-struct Transform2d {
-  double x = 0, y = 0, theta = 0;  // m, m, rad
-
-  Eigen::Vector2d apply(const Eigen::Vector2d& p) const;
-  // (a.compose(b)).apply(p) == a.apply(b.apply(p)): b first, then a.
-  Transform2d compose(const Transform2d& b) const;
-  Transform2d inverse() const;
-};
-
-// Wraps an angle to (-pi, pi].
-double wrap_angle(double a);
-
-// The map's curb points for nearest-neighbour queries. Keeps its own copy of the points, so it is safe
-// to move and to build from a temporary.
-//
-// Two structures answer two kinds of question. nearest() has no bound and uses a KD-tree (nanoflann).
-// ICP only ever wants the nearest point within a gate (d_g, the correspondence window), and asks
-// thousands of times a scan: nearest_within() answers from square buckets, scanning only the buckets the
-// gate's circle touches. A curb map is lines of points 0.1 m apart, so a 1 m bucket holds ten or so and
-// the answer comes from a few contiguous runs of memory instead of a tree descent (benchmarks/
-// bench_curb_matching.cpp measures both).
-class MapIndex {
- public:
-  static constexpr double kDefaultBucketM = 1.0;  // the paper's d_g: global ICP's gate in one ring
-
-  explicit MapIndex(std::vector<Eigen::Vector2d> points, double bucket_m = kDefaultBucketM);
-  ~MapIndex();
-  MapIndex(MapIndex&&) noexcept;
-  MapIndex& operator=(MapIndex&&) noexcept;
-
-  const std::vector<Eigen::Vector2d>& points() const { return points_; }
-  bool empty() const { return points_.empty(); }
-  // Index of and Euclidean distance to the nearest map point; (SIZE_MAX, inf) for an empty map.
-  std::pair<size_t, double> nearest(const Eigen::Vector2d& p) const;
-  // The nearest map point if it is within `radius` (the same point nearest() finds, ties aside);
-  // otherwise, or for a non-finite p, (SIZE_MAX, inf).
-  std::pair<size_t, double> nearest_within(const Eigen::Vector2d& p, double radius) const;
-
- private:
-  struct Tree;
-  // Row-major buckets over the points' bounding box; the points re-ordered bucket by bucket, so the
-  // buckets of one row of a query's neighbourhood are one contiguous run.
-  struct Buckets {
-    Eigen::Vector2d origin = Eigen::Vector2d::Zero();
-    double size = kDefaultBucketM;
-    int cols = 0, rows = 0;
-    std::vector<uint32_t> start;            // bucket k holds sorted[start[k] .. start[k + 1])
-    std::vector<Eigen::Vector2d> sorted;    // the points in bucket order
-    std::vector<uint32_t> index;            // sorted[i] is points_[index[i]]
-  };
-  std::vector<Eigen::Vector2d> points_;
-  std::unique_ptr<Tree> tree_;
-  Buckets buckets_;
-};
 
 // Closed-form weighted least-squares rigid fit minimising sum w_i |T src_i - dst_i|^2: the SVD step of
 // the paper's ICP [43]. In 2-D the SVD of the 2x2 cross-covariance reduces to one atan2, which is exact
 // and cannot produce a reflection. Null weights = all 1. Fewer than one usable pair -> identity; one
 // pair -> pure translation.
-Transform2d fit_rigid_2d(const std::vector<Eigen::Vector2d>& src, const std::vector<Eigen::Vector2d>& dst,
+Pose2d fit_rigid_2d(const std::vector<Eigen::Vector2d>& src, const std::vector<Eigen::Vector2d>& dst,
                          const std::vector<double>* weights = nullptr);
 
 struct IcpParams {
@@ -89,7 +34,7 @@ struct IcpParams {
 };
 
 struct IcpResult {
-  Transform2d t;
+  Pose2d t;
   double rmse = 0;           // m, over the final inliers
   int iterations = 0;        // ICP: updates made; probabilistic ICP: draws fused (n_t)
   double outlier_ratio = 1;  // fraction of curbs farther than the rejection distance from the map under t
@@ -100,7 +45,7 @@ struct IcpResult {
 // Correspondences farther than min(max_correspondence, reject_distance) are dropped each iteration
 // (with reject_distance = d_g this is Eq. 12); the same distance defines outliers in the result.
 // Empty curbs or map: returns `initial` with outlier_ratio 1.
-IcpResult icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Transform2d initial,
+IcpResult icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial,
               const IcpParams& params, double reject_distance = std::numeric_limits<double>::infinity());
 
 struct MIcpParams {
@@ -118,7 +63,7 @@ struct MIcpParams {
 // M-ICP baseline (Eq. 21-22): minimises sum rho(|T C_i - M| / scale) by iteratively reweighted least
 // squares with the biweight weight w(u) = (1 - (u/B)^2)^2 for |u| < B, else 0 (rho'(u)/u of Eq. 22).
 // Outliers in the result are curbs with zero weight (residual beyond B * scale).
-IcpResult m_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Transform2d initial,
+IcpResult m_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial,
                 const MIcpParams& params);
 
 struct ProbabilisticIcpParams {
@@ -139,7 +84,7 @@ struct ProbabilisticIcpParams {
 
 // One draw's global-ICP result, as fused by Eq. 13.
 struct IcpHypothesis {
-  Transform2d t;
+  Pose2d t;
   double outlier_ratio = 1;
 };
 
@@ -147,7 +92,7 @@ struct IcpHypothesis {
 // an outlier ratio (softness in curbs / number of curbs): w_i = exp(-(eta_i - eta_min) / temperature),
 // then the weighted mean of x, y, and of theta as an angle (atan2 of the weighted sines and cosines).
 // Temperature 0 keeps only the best draws. Empty input -> identity.
-Transform2d fuse_hypotheses(const std::vector<IcpHypothesis>& hypotheses, double outlier_temperature);
+Pose2d fuse_hypotheses(const std::vector<IcpHypothesis>& hypotheses, double outlier_temperature);
 
 // Probabilistic ICP (section 3.1). All n_t samples are drawn from `rng` up front in a fixed order, so
 // the result depends only on the inputs and the engine state, and the draws could run in parallel.
@@ -155,6 +100,6 @@ Transform2d fuse_hypotheses(const std::vector<IcpHypothesis>& hypotheses, double
 // with outlier_ratio 1. The result's outlier_ratio, inliers and rmse are those of the fused transform
 // against d_g.
 IcpResult probabilistic_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs,
-                            Transform2d initial, const ProbabilisticIcpParams& params, std::mt19937_64& rng);
+                            Pose2d initial, const ProbabilisticIcpParams& params, std::mt19937_64& rng);
 
 }  // namespace lidarloop

@@ -23,12 +23,6 @@ void require(bool ok, const std::string& what) {
 bool finite_non_negative(double v) { return std::isfinite(v) && v >= 0; }
 bool finite_positive(double v) { return std::isfinite(v) && v > 0; }
 
-// Angle in (-pi, pi].
-double wrap_angle(double a) {
-  a = std::remainder(a, 2 * std::numbers::pi);  // [-pi, pi]
-  return a <= -std::numbers::pi ? a + 2 * std::numbers::pi : a;
-}
-
 // One step of the exact discretisation of a first-order Gauss-Markov process: the stationary
 // standard deviation stays `sigma` and the correlation time `tau` whatever dt is.
 double gauss_markov_step(double b, double dt_s, double sigma, double tau_s, double n) {

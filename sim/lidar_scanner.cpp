@@ -1,4 +1,5 @@
 #include "sim/lidar_scanner.hpp"
+#include "common/units.hpp"
 
 #include <cmath>
 
@@ -7,7 +8,6 @@
 
 namespace lidarloop {
 
-constexpr double kDeg = M_PI / 180;
 
 PoseAt constant_twist(const Eigen::Isometry3d& start, int64_t t0_ns, double v, double w) {
   return [=](int64_t t_ns) {

@@ -90,14 +90,14 @@ static double smooth_heading(const Path& p, double s) {
   if (p.closed && after && j < i) mj += p.length;
   if (p.closed && !after && j > i) mj -= p.length;
   const double u = std::clamp((s - mid(i)) / (mj - mid(i)), 0.0, 1.0);
-  return heading(i) + u * std::remainder(heading(j) - heading(i), 2 * M_PI);
+  return heading(i) + u * wrap_angle(heading(j) - heading(i));
 }
 
 double Path::curvature_at(double s) const {
   if (points.size() < 3) return 0.0;
   const double a = smooth_heading(*this, s - kCurvatureWindow), b = smooth_heading(*this, s + kCurvatureWindow);
   const double span = closed ? 2 * kCurvatureWindow : wrap(s + kCurvatureWindow) - wrap(s - kCurvatureWindow);
-  return span > 0 ? std::remainder(b - a, 2 * M_PI) / span : 0.0;
+  return span > 0 ? wrap_angle(b - a) / span : 0.0;
 }
 
 Path lane_path(const RoadSpec& road, Lane lane, bool backward, const double* offset) {

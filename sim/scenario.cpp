@@ -2,13 +2,14 @@
 
 #include <cmath>
 
+#include "common/localizer_method.hpp"
+#include "common/units.hpp"
 #include "common/yaml_reader.hpp"
 #include "sim/region.hpp"
 
 namespace lidarloop {
 namespace {
 
-constexpr double kDeg = M_PI / 180;
 constexpr double kMaxDuration = 24 * 3600;  // s
 constexpr double kMaxSpeed = 40;            // m/s for any actor
 constexpr double kPathCheckStep = 1.0;      // m between on-road checks
@@ -213,11 +214,10 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
     y.expect_map(l, "localizer");
     if (l["method"]) {
       s.localizer_method = y.string(l["method"], "method");
-      const auto& m = localizer_methods();
-      if (std::find(m.begin(), m.end(), s.localizer_method) == m.end()) {
-        std::string list;
-        for (const auto& name : m) list += (list.empty() ? "" : ", ") + name;
-        y.fail(l["method"], "unknown localizer method '" + s.localizer_method + "' (expected one of: " + list + ")");
+      try {
+        parse_localizer_method(s.localizer_method);
+      } catch (const std::invalid_argument& e) {
+        y.fail(l["method"], e.what());
       }
     }
   }
@@ -282,11 +282,6 @@ void check_on_network(const Path& path, const region::Paths& area, const std::st
 }
 
 }  // namespace
-
-const std::vector<std::string>& localizer_methods() {
-  static const std::vector<std::string> methods = {"gps", "icp", "icp-obs", "m-icp", "intensity", "fmt", "proposed"};
-  return methods;
-}
 
 Scenario load_scenario(const std::string& path, const VehicleParams& vehicle) {
   return parse(YamlReader::open(path), vehicle);

@@ -95,9 +95,6 @@ struct Scenario {
 Scenario load_scenario(const std::string& path, const VehicleParams& vehicle = {});
 Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle = {});
 
-// The localizer methods a scenario may name (the paper's baselines and its proposal).
-const std::vector<std::string>& localizer_methods();
-
 struct ResolvedScenario {
   Path ego_route;
   std::vector<ActorPlan> actors;

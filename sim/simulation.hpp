@@ -13,15 +13,6 @@
 
 namespace lidarloop {
 
-struct TruthSample {
-  int64_t stamp_ns = 0;
-  Pose2d pose;             // rear axle centre (the vehicle frame origin)
-  double speed = 0;        // m/s
-  double yaw_rate = 0;     // rad/s
-  double steer = 0;        // front wheel angle, rad
-  double cross_track = 0;  // controller's lateral error to its route, m
-};
-
 struct ActorSample {
   std::string name;
   ActorType type;

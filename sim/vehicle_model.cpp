@@ -1,4 +1,5 @@
 #include "sim/vehicle_model.hpp"
+#include "common/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,6 @@ namespace lidarloop {
 
 namespace {
 
-constexpr double kNsPerSecond = 1e9;
 constexpr double kTyresPerAxle = 2;        // Eq. 19's "2 C": the stiffness parameters are per tyre
 constexpr double kBlendWidth = 1.0;        // m/s: kinematic -> Eq. 19 over kinematic_below -+ half of this
 constexpr double kNegligibleWeight = 1e-6; // Eq. 19's weight below which its states are reset (see step())
@@ -172,7 +172,7 @@ void VehicleModel::step(const VehicleCommand& command) {
   if (!std::isfinite(command.steer) || !std::isfinite(command.accel))
     throw std::invalid_argument("VehicleModel::step: the command is not finite");
   const VehicleParams& p = params_;
-  const double dt = double(p.step_ns) / kNsPerSecond;
+  const double dt = double(p.step_ns) / kNsPerS;
 
   // Steering actuator: first-order lag towards the (clamped) command, rate- and range-limited.
   const double steer_cmd = std::clamp(command.steer, -p.max_steer, p.max_steer);
@@ -224,7 +224,7 @@ void VehicleModel::step(const VehicleCommand& command) {
   VehicleState next;
   next.x = c1.x;
   next.y = c1.y;
-  next.yaw = std::remainder(c1.yaw, 2 * M_PI);
+  next.yaw = wrap_angle(c1.yaw);
   next.steer = steer1;
   next.accel = accel1;
   // No reversing and no speeding: a standing car's brakes hold it, they do not push it backwards.

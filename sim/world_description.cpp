@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "common/units.hpp"
 #include "common/yaml_reader.hpp"
 #include "sim/actor_assets.hpp"
 #include "sim/polyline.hpp"
@@ -9,7 +10,6 @@
 namespace lidarloop {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kMaxArcStep = 3.0 * kDeg;  // fillet arcs are split every 3 degrees
 constexpr double kMinSegment = 0.01;        // m; shorter centreline segments are input errors
 constexpr double kMaxTurn = 170.0 * kDeg;   // sharper turns between segments are a road doubling back

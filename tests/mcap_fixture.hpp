@@ -8,8 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/simulation.hpp"
-#include "tools/mcap/mcap_recorder.hpp"
+#include "logs/mcap_recorder.hpp"
 
 namespace lidarloop::test {
 
@@ -25,7 +24,7 @@ struct SyntheticRun {
   std::vector<CanFrame> can;
   std::vector<GpsFix> gps, rtk;
   std::vector<PointCloud> scans;
-  std::vector<std::pair<int64_t, std::vector<ActorSample>>> actors;
+  std::vector<std::pair<int64_t, std::vector<ros2::ActorState>>> actors;
   std::vector<SyntheticEstimate> estimates;
   std::string scenario_yaml = "world: campus\nduration_s: 1\nseed: 7\n";
 };
@@ -80,8 +79,8 @@ inline SyntheticRun make_synthetic_run(double seconds, int points, uint64_t seed
       }
       run.scans.push_back(std::move(cloud));
       run.actors.push_back({t - 10 * step,
-                            {{"bus_1", ActorType::bus, {u(rng) * 50, u(rng) * 50, u(rng)}},
-                             {"walker", ActorType::pedestrian, {u(rng) * 50, u(rng) * 50, u(rng)}}}});
+                            {{"bus_1", "bus", {u(rng) * 50, u(rng) * 50, u(rng)}},
+                             {"walker", "pedestrian", {u(rng) * 50, u(rng) * 50, u(rng)}}}});
       SyntheticEstimate e;
       e.stamp_ns = t - 10 * step;
       e.pose = {s.pose.x + 0.1 * u(rng), s.pose.y + 0.1 * u(rng), s.pose.yaw + 0.01 * u(rng)};
@@ -101,15 +100,15 @@ inline McapWriterStats record_synthetic_run(const SyntheticRun& run, const std::
   size_t gps = 0, scan = 0;
   for (size_t i = 0; i < run.truth.size(); ++i) {
     const int64_t t = run.truth[i].stamp_ns;
-    rec.on_can(run.can[i]);
-    rec.on_truth(run.truth[i]);
+    rec.write_can(run.can[i]);
+    rec.write_truth(run.truth[i]);
     if (gps < run.gps.size() && run.gps[gps].stamp_ns == t) {
-      rec.on_gps(run.gps[gps]);
-      rec.on_rtk(run.rtk[gps++]);
+      rec.write_gps(run.gps[gps]);
+      rec.write_rtk(run.rtk[gps++]);
     }
     if (scan < run.scans.size() && run.scans[scan].stamp_ns + 100'000'000 == t) {
-      rec.on_scan(run.scans[scan], Eigen::Isometry3d::Identity());
-      rec.on_actors(run.actors[scan].first, run.actors[scan].second);
+      rec.write_scan(run.scans[scan]);
+      rec.write_actors(run.actors[scan].first, run.actors[scan].second);
       const auto& e = run.estimates[scan++];
       rec.write_estimate(e.stamp_ns, e.pose, e.cov);
     }

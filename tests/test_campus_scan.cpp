@@ -6,7 +6,7 @@
 #include "sim/polyline.hpp"
 #include "test_support.hpp"
 #include "tools/ply_file.hpp"
-#include "tools/world_assets.hpp"
+#include "loop/world_assets.hpp"
 
 namespace lidarloop {
 namespace {

@@ -8,7 +8,7 @@
 #include "sim/lidar_scanner.hpp"
 #include "sim/polyline.hpp"
 #include "test_support.hpp"
-#include "tools/world_assets.hpp"
+#include "loop/world_assets.hpp"
 
 namespace lidarloop {
 namespace {

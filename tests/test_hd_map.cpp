@@ -10,7 +10,7 @@
 #include "localizer/curb_layer.hpp"
 #include "localizer/hd_map.hpp"
 #include "test_support.hpp"
-#include "tools/mapping_drive.hpp"
+#include "loop/mapping_drive.hpp"
 
 namespace lidarloop {
 namespace {

@@ -11,15 +11,15 @@
 
 #include "common/input_error.hpp"
 #include "mcap_fixture.hpp"
-#include "tools/mcap/cdr.hpp"
+#include "logs/cdr.hpp"
 #include "common/crc32.hpp"
-#include "tools/mcap/log_export.hpp"
-#include "tools/mcap/log_topics.hpp"
-#include "tools/mcap/mcap_reader.hpp"
-#include "tools/mcap/mcap_recover.hpp"
-#include "tools/mcap/ros2_messages.hpp"
-#include "tools/mcap/ros2_schemas.hpp"
-#include "tools/mcap/zstd_codec.hpp"
+#include "logs/log_export.hpp"
+#include "logs/log_topics.hpp"
+#include "logs/mcap/mcap_reader.hpp"
+#include "logs/mcap/mcap_recover.hpp"
+#include "logs/ros2_messages.hpp"
+#include "logs/ros2_schemas.hpp"
+#include "logs/mcap/zstd_codec.hpp"
 
 namespace lidarloop {
 namespace {

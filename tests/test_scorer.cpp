@@ -11,9 +11,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/input_error.hpp"
-#include "tools/error_plots.hpp"
-#include "tools/result_files.hpp"
-#include "tools/scorer.hpp"
+#include "loop/error_plots.hpp"
+#include "loop/result_files.hpp"
+#include "loop/scorer.hpp"
 
 namespace lidarloop {
 namespace {

@@ -5,7 +5,7 @@
 
 #include "sim/simulation.hpp"
 #include "test_support.hpp"
-#include "tools/world_assets.hpp"
+#include "loop/world_assets.hpp"
 
 namespace lidarloop {
 namespace {

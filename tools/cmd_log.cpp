@@ -6,9 +6,9 @@
 
 #include "common/input_error.hpp"
 #include "tools/commands.hpp"
-#include "tools/mcap/log_export.hpp"
-#include "tools/mcap/mcap_reader.hpp"
-#include "tools/mcap/mcap_recover.hpp"
+#include "logs/log_export.hpp"
+#include "logs/mcap/mcap_reader.hpp"
+#include "logs/mcap/mcap_recover.hpp"
 
 namespace lidarloop {
 

@@ -10,9 +10,9 @@
 #include "localizer/hd_map.hpp"
 #include "sim/path.hpp"
 #include "tools/commands.hpp"
-#include "tools/map_cache.hpp"
+#include "loop/map_cache.hpp"
 #include "tools/scene_setup.hpp"
-#include "tools/world_assets.hpp"
+#include "loop/world_assets.hpp"
 
 namespace lidarloop {
 

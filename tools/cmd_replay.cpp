@@ -9,13 +9,13 @@
 #include "common/input_error.hpp"
 #include "localizer/localizer.hpp"
 #include "tools/commands.hpp"
-#include "tools/localizer_setup.hpp"
-#include "tools/mcap/log_topics.hpp"
-#include "tools/mcap/mcap_reader.hpp"
-#include "tools/mcap/ros2_messages.hpp"
-#include "tools/result_files.hpp"
-#include "tools/run_outputs.hpp"
-#include "tools/run_recording.hpp"
+#include "loop/localizer_setup.hpp"
+#include "logs/log_topics.hpp"
+#include "logs/mcap/mcap_reader.hpp"
+#include "logs/ros2_messages.hpp"
+#include "loop/result_files.hpp"
+#include "loop/run_outputs.hpp"
+#include "loop/run_recording.hpp"
 
 namespace lidarloop {
 namespace {

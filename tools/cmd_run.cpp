@@ -10,11 +10,11 @@
 
 #include "common/input_error.hpp"
 #include "tools/commands.hpp"
-#include "tools/localizer_loop.hpp"
-#include "tools/localizer_setup.hpp"
-#include "tools/result_files.hpp"
-#include "tools/run_outputs.hpp"
-#include "tools/run_recording.hpp"
+#include "loop/localizer_loop.hpp"
+#include "loop/localizer_setup.hpp"
+#include "loop/result_files.hpp"
+#include "loop/run_outputs.hpp"
+#include "loop/run_recording.hpp"
 #include "tools/scene_setup.hpp"
 
 namespace lidarloop {
@@ -64,16 +64,16 @@ int run_run(const Args& args) {
   HdMap map = open_scenario_map(s.scenario, s.world);
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_name(params.method), s.scenario.duration_s};
-  const std::unique_ptr<McapRecorder> recorder =
+  const std::unique_ptr<RecordingSink> recorder =
       start_recording(args.value("record"), s.scenario, method_name(params.method));
   std::function<void(const LocalizerEstimate&)> record_estimate;
   if (recorder)
     record_estimate = [&](const LocalizerEstimate& e) {
-      if (!(e.health & kNotInitialized)) recorder->write_estimate(e.stamp_ns, e.pose, e.covariance);
+      if (!(e.health & kNotInitialized)) recorder->log().write_estimate(e.stamp_ns, e.pose, e.covariance);
     };
   const LoopResult r = run_localizer_loop(sim, map, {params}, s.scenario.closed_loop, recorder.get(),
                                           std::ref(progress), record_estimate);
-  if (recorder) recorder->close();
+  if (recorder) recorder->log().close();
   progress.clear();
 
   const MethodTrace& trace = r.methods.front();
@@ -180,7 +180,7 @@ Command run_command() {
            "Run a scenario with the localizer in the loop and score it against ground truth. Writes\n"
            "metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and plots to DIR. Exit 0 when\n"
            "every threshold of the scenario's `pass` holds, 1 when one fails, 2 on bad input.",
-           {{"method", "NAME", "gps, icp, icp-obs, m-icp, fmt, intensity or proposed (default: the scenario's)"},
+           {{"method", "NAME", method_name_list() + " (default: the scenario's)"},
             {"loop", "open|closed", "closed: the controller steers on the estimate (default: the scenario's)"},
             {"out", "DIR", "output folder (default out/<scenario name>)"},
             {"seed", "N", "override the scenario's seed"},

@@ -4,14 +4,14 @@
 #include <iostream>
 #include <thread>
 
-#include "tools/birdseye.hpp"
+#include "common/units.hpp"
+#include "loop/birdseye.hpp"
 #include "tools/commands.hpp"
 #include "tools/ply_file.hpp"
 #include "tools/scene_setup.hpp"
 
 namespace lidarloop {
 
-constexpr double kDeg = M_PI / 180;
 
 int thread_count(const Args& args) {
   const long n = args.integer("threads", 0, 0, 1024);

@@ -8,8 +8,8 @@
 
 #include "tools/commands.hpp"
 #include "tools/csv_streams.hpp"
-#include "tools/localizer_setup.hpp"
-#include "tools/run_recording.hpp"
+#include "loop/localizer_setup.hpp"
+#include "loop/run_recording.hpp"
 #include "tools/scene_setup.hpp"
 #include "tools/world_map_png.hpp"
 
@@ -38,7 +38,7 @@ int run_simulate(const Args& args) {
 
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   CsvStreams streams(out, LocalFrame(s.world.description.origin), scan_every);
-  const std::unique_ptr<McapRecorder> recorder = start_recording(args.value("record"), s.scenario, "");
+  const std::unique_ptr<RecordingSink> recorder = start_recording(args.value("record"), s.scenario, "");
   TeeSink sink(streams, recorder.get());
   const bool terminal = isatty(STDOUT_FILENO);
   const auto t0 = std::chrono::steady_clock::now();
@@ -48,7 +48,7 @@ int run_simulate(const Args& args) {
                 s.scenario.duration_s);
     std::fflush(stdout);
   });
-  if (recorder) recorder->close();
+  if (recorder) recorder->log().close();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (terminal) std::printf("\r%60s\r", "");
 

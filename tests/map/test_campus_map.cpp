@@ -7,8 +7,8 @@
 
 #include "localizer/hd_map.hpp"
 #include "sim/ray_scene.hpp"
-#include "tools/map_cache.hpp"
-#include "tools/world_assets.hpp"
+#include "loop/map_cache.hpp"
+#include "loop/world_assets.hpp"
 
 namespace lidarloop {
 namespace {

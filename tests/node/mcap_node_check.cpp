@@ -11,8 +11,8 @@
 
 #include "common/input_error.hpp"
 #include "../mcap_fixture.hpp"
-#include "tools/mcap/log_topics.hpp"
-#include "tools/mcap/mcap_reader.hpp"
+#include "logs/log_topics.hpp"
+#include "logs/mcap/mcap_reader.hpp"
 
 using namespace lidarloop;
 using nlohmann::json;

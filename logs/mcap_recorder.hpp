@@ -1,0 +1,65 @@
+#pragma once
+// Records a run as an MCAP log a ROS 2 / Foxglove user can open: every sensor stream, the ground
+// truth, the localizer's estimate, and the run's scenario and settings as an attachment and metadata.
+// Topics, types and frames are listed in log_topics.hpp. It knows messages, not where they come from:
+// the simulator's streams reach it through an adapter in loop/ (run_recording.hpp).
+//
+// Channels are registered when their first message arrives, so a log holds only the streams the run
+// produced. The same calls in the same order give the same bytes (see McapWriter).
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include <Eigen/Geometry>
+
+#include "common/point_cloud.hpp"
+#include "common/vehicle_messages.hpp"
+#include "logs/mcap/mcap_writer.hpp"
+#include "logs/ros2_messages.hpp"
+
+namespace lidarloop {
+
+class McapRecorder {
+ public:
+  // `lidar_mount`: the LiDAR's pose in the vehicle frame, published once on /tf_static.
+  McapRecorder(const std::string& path, const Eigen::Isometry3d& lidar_mount, McapWriterOptions options = {});
+
+  void write_truth(const TruthSample& truth);
+  void write_can(const CanFrame& frame);
+  void write_gps(const GpsFix& fix);
+  void write_rtk(const GpsFix& fix);
+  void write_scan(const PointCloud& cloud);
+  void write_actors(int64_t stamp_ns, const std::vector<ros2::ActorState>& actors);
+
+  // The localizer's estimate: /localizer/odometry (covariance of x, y, yaw) and /tf.
+  void write_estimate(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& cov_xy_yaw);
+
+  // Logged at the current log time (the newest stamp seen so far), never at wall-clock time.
+  void add_attachment(const std::string& name, const std::string& media_type, std::span<const uint8_t> bytes);
+  void add_attachment(const std::string& name, const std::string& media_type, std::string_view bytes);
+  void add_metadata(const std::string& name, const std::map<std::string, std::string>& values);
+
+  // Finishes the file (summary, footer). The destructor does it too, but swallows errors.
+  void close();
+
+  McapWriterStats stats() const { return writer_.stats(); }
+  const std::string& path() const { return writer_.path(); }
+
+ private:
+  struct ChannelSpec {
+    const char* topic;
+    const char* type;
+    bool latched = false;  // /tf_static: transient-local durability, as ROS 2 publishes it
+  };
+  void write(const ChannelSpec& spec, int64_t stamp_ns, const std::vector<uint8_t>& data);
+  uint16_t channel(const ChannelSpec& spec);
+
+  McapWriter writer_;
+  std::map<std::string, uint16_t> schemas_, channels_;  // by type, by topic
+  uint64_t clock_ = 0;  // log time: the newest stamp received
+  std::vector<uint8_t> scan_buffer_;  // a scan's CDR, reused from scan to scan
+};
+
+}  // namespace lidarloop

@@ -1,0 +1,314 @@
+#include "loop/localizer_loop.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <variant>
+
+namespace lidarloop {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct ScanMessage {
+  PointCloud cloud;
+  Eigen::Isometry3d sensor_pose;
+};
+// What the localizers consume, in the order the simulation emitted it.
+using Message = std::variant<TruthSample, CanFrame, GpsFix, ScanMessage>;
+
+// The localizers and what they produced. One thread at a time calls process(); nothing else is shared.
+class Localizers {
+ public:
+  Localizers(HdMap& map, const std::vector<LocalizerParams>& methods, LoopResult& result) : result_(result) {
+    for (const auto& p : methods) {
+      localizers_.push_back(std::make_unique<Localizer>(map, p));
+      result_.methods.push_back({method_name(p.method), {}, {}});
+    }
+  }
+
+  // Returns the first method's estimate for a scan, nothing for the other messages.
+  std::optional<LocalizerEstimate> process(const Message& m) {
+    const auto t0 = Clock::now();
+    std::optional<LocalizerEstimate> primary;
+    if (const auto* t = std::get_if<TruthSample>(&m)) latest_truth_ = t->pose;
+    if (const auto* f = std::get_if<CanFrame>(&m))
+      for (auto& l : localizers_) l->on_can(*f);
+    if (const auto* f = std::get_if<GpsFix>(&m))
+      for (auto& l : localizers_) l->on_gps(*f);
+    if (const auto* s = std::get_if<ScanMessage>(&m)) {
+      for (size_t i = 0; i < localizers_.size(); ++i) {
+        LocalizerEstimate e = localizers_[i]->on_scan(s->cloud);
+        MethodTrace& trace = result_.methods[i];
+        // The latest truth sample is at most one truth period from the estimate: close enough to pick
+        // the worst frame (the scorer interpolates properly).
+        if (latest_truth_ && !(e.health & kNotInitialized)) {
+          const double error = std::hypot(e.pose.x - latest_truth_->x, e.pose.y - latest_truth_->y);
+          if (error > trace.worst.error_m)
+            trace.worst = {error, s->cloud, s->sensor_pose, localizers_[i]->last_features(), *latest_truth_, e.pose};
+        }
+        if (i == 0) primary = e;
+        trace.estimates.push_back(std::move(e));
+      }
+    }
+    result_.localizer_wall_s += std::chrono::duration<double>(Clock::now() - t0).count();
+    return primary;
+  }
+
+ private:
+  std::vector<std::unique_ptr<Localizer>> localizers_;
+  std::optional<Pose2d> latest_truth_;
+  LoopResult& result_;
+};
+
+// The localizers run on a thread of their own while the simulation computes the next scan, so the two
+// cores are both busy. The localizers see the same messages in the same order as in series, so they
+// give the same estimates; in closed loop the controller gets them a scan late (see DelayedPose).
+// The recorder (`also`) still sees everything in the serial order: scan k, its estimate, the messages
+// up to scan k + 1. Messages after scan k are held back until estimate k is out, which the
+// simulation waits for at scan k + 1 at the latest.
+class PipelinedSink : public StreamSink {
+ public:
+  PipelinedSink(Localizers& localizers, StreamSink* also, const std::function<void(const LocalizerEstimate&)>& on_estimate)
+      : localizers_(localizers), also_(also), on_estimate_(on_estimate), worker_([this] { work(); }) {}
+  ~PipelinedSink() override { stop(); }
+
+  void on_truth(const TruthSample& t) override {
+    push(t);
+    hold([this, t] { also_->on_truth(t); });
+  }
+  void on_can(const CanFrame& f) override {
+    push(f);
+    hold([this, f] { also_->on_can(f); });
+  }
+  void on_gps(const GpsFix& f) override {
+    push(f);
+    hold([this, f] { also_->on_gps(f); });
+  }
+  void on_rtk(const GpsFix& f) override {
+    hold([this, f] { also_->on_rtk(f); });
+  }
+  void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override {
+    hold([this, stamp_ns, actors] { also_->on_actors(stamp_ns, actors); });
+  }
+  void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
+    release_previous_scan();
+    if (also_) also_->on_scan(cloud, sensor_pose);
+    push(ScanMessage{cloud, sensor_pose});
+    scan_outstanding_ = true;
+  }
+
+  // Waits for the last scan's estimate, hands out everything held back and stops the worker once it
+  // has processed everything; rethrows what the localizers threw. Call after the run.
+  void finish() {
+    release_previous_scan();
+    stop();
+    if (failure_) std::rethrow_exception(failure_);
+  }
+
+ private:
+  void stop() {
+    if (!worker_.joinable()) return;
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    wake_worker_.notify_one();
+    worker_.join();
+  }
+  void push(Message m) {
+    {
+      std::lock_guard lock(mutex_);
+      queue_.push_back(std::move(m));
+    }
+    wake_worker_.notify_one();
+  }
+  void hold(std::function<void()> f) {
+    if (!also_) return;
+    if (scan_outstanding_)
+      held_.push_back(std::move(f));
+    else
+      f();
+  }
+  void release_previous_scan() {
+    if (!scan_outstanding_) return;
+    LocalizerEstimate e;
+    {
+      std::unique_lock lock(mutex_);
+      estimate_ready_.wait(lock, [this] { return !estimates_.empty() || failure_; });
+      if (failure_) std::rethrow_exception(failure_);
+      e = std::move(estimates_.front());
+      estimates_.pop_front();
+    }
+    scan_outstanding_ = false;
+    if (on_estimate_) on_estimate_(e);
+    for (auto& f : held_) f();
+    held_.clear();
+  }
+
+  void work() {
+    for (;;) {
+      Message m;
+      {
+        std::unique_lock lock(mutex_);
+        wake_worker_.wait(lock, [this] { return !queue_.empty() || stop_; });
+        if (queue_.empty()) return;  // stopped, and everything processed
+        m = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      try {
+        std::optional<LocalizerEstimate> e = localizers_.process(m);
+        if (e) {
+          std::lock_guard lock(mutex_);
+          estimates_.push_back(std::move(*e));
+        }
+        if (e) estimate_ready_.notify_one();
+      } catch (...) {
+        std::lock_guard lock(mutex_);
+        failure_ = std::current_exception();
+        estimate_ready_.notify_one();
+        return;
+      }
+    }
+  }
+
+  Localizers& localizers_;
+  StreamSink* also_;
+  std::function<void(const LocalizerEstimate&)> on_estimate_;
+  bool scan_outstanding_ = false;              // simulation thread only
+  std::vector<std::function<void()>> held_;    // simulation thread only
+  std::mutex mutex_;                           // guards the four below
+  std::condition_variable wake_worker_, estimate_ready_;
+  std::deque<Message> queue_;
+  std::deque<LocalizerEstimate> estimates_;
+  std::exception_ptr failure_;
+  bool stop_ = false;
+  std::thread worker_;  // last: starts once everything above exists
+};
+
+// The controller's pose in closed loop. The localizer runs beside the simulation, so estimate k is
+// not there while scan k is being processed: the controller steers on the newest estimate handed out
+// (the previous scan's, 0.1-0.2 s old) brought up to the present with CAN odometry (Eq. 19), which is
+// what a real car's controller does with a localizer's output. Which estimate is the newest depends
+// only on the simulation's events (estimate k is handed out at scan k + 1), never on how fast the
+// worker is, so closed-loop runs stay deterministic. Until the first estimate: ground truth.
+class DelayedPose {
+ public:
+  explicit DelayedPose(const LocalizerParams& params) : params_(params) {}
+
+  void on_can(const CanFrame& f) {
+    const CanMotion m = can_motion(f, params_.vehicle);
+    if (!std::isfinite(m.speed) || !std::isfinite(m.steer)) return;
+    if (!history_.empty() && f.stamp_ns < history_.back().stamp_ns) return;  // stale, as the localizer
+    Odometry o = history_.empty() ? Odometry{f.stamp_ns, {}, {}, MotionPredictor(params_.vehicle)}
+                                  : advanced(history_.back(), f.stamp_ns);
+    o.motion = m;
+    history_.push_back(o);
+    // Keep what a handed-out estimate can still be referred to.
+    const int64_t keep_from = estimate_ ? estimate_->stamp_ns : f.stamp_ns - kKeepWithoutEstimateNs;
+    while (history_.size() > 1 && history_[1].stamp_ns <= keep_from) history_.pop_front();
+  }
+  void on_estimate(const LocalizerEstimate& e) {
+    if (!(e.health & kNotInitialized)) estimate_ = Stamped{e.stamp_ns, e.pose};
+  }
+  Pose2d pose(int64_t t_ns, const Pose2d& truth) const {
+    if (!estimate_ || history_.empty()) return truth;
+    return estimate_->pose.compose(relative(odometry_at(estimate_->stamp_ns), odometry_at(t_ns)));
+  }
+
+ private:
+  static constexpr int64_t kKeepWithoutEstimateNs = 1'000'000'000;
+  struct Stamped {
+    int64_t stamp_ns;
+    Pose2d pose;
+  };
+  // Dead reckoning in a frame of its own, as of a CAN frame, with that frame's speed and steering.
+  struct Odometry {
+    int64_t stamp_ns;
+    Pose2d pose;
+    CanMotion motion;
+    MotionPredictor predictor;
+  };
+  // `o` driven on to t_ns in the localizer's Euler steps.
+  Odometry advanced(Odometry o, int64_t t_ns) const {
+    if (t_ns <= o.stamp_ns) return o;
+    o.pose = o.predictor.advance(o.pose, o.motion.speed, o.motion.steer, t_ns - o.stamp_ns,
+                                 params_.max_prediction_step_s);
+    o.stamp_ns = t_ns;
+    return o;
+  }
+  Pose2d odometry_at(int64_t t_ns) const {
+    auto after = std::upper_bound(history_.begin(), history_.end(), t_ns,
+                                  [](int64_t t, const Odometry& o) { return t < o.stamp_ns; });
+    return advanced(after == history_.begin() ? history_.front() : *std::prev(after), t_ns).pose;
+  }
+
+  const LocalizerParams& params_;
+  std::deque<Odometry> history_;
+  std::optional<Stamped> estimate_;
+};
+
+// What the simulation thread itself takes from the streams before the localizers' sink: the truth for
+// the scorer, the scan count, and the CAN frames the controller's dead reckoning needs.
+class SimulationTap : public StreamSink {
+ public:
+  SimulationTap(StreamSink& next, std::vector<TruthSample>& truth, size_t& scans, DelayedPose* controller_pose)
+      : next_(next), truth_(truth), scans_(scans), controller_pose_(controller_pose) {}
+  void on_truth(const TruthSample& t) override {
+    truth_.push_back(t);
+    next_.on_truth(t);
+  }
+  void on_can(const CanFrame& f) override {
+    if (controller_pose_) controller_pose_->on_can(f);
+    next_.on_can(f);
+  }
+  void on_gps(const GpsFix& f) override { next_.on_gps(f); }
+  void on_rtk(const GpsFix& f) override { next_.on_rtk(f); }
+  void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& a) override { next_.on_actors(stamp_ns, a); }
+  void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
+    ++scans_;
+    next_.on_scan(cloud, sensor_pose);
+  }
+
+ private:
+  StreamSink& next_;
+  std::vector<TruthSample>& truth_;
+  size_t& scans_;
+  DelayedPose* controller_pose_;
+};
+
+}  // namespace
+
+LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<LocalizerParams>& methods,
+                              bool closed_loop, StreamSink* also, const std::function<void(double)>& progress,
+                              const std::function<void(const LocalizerEstimate&)>& on_estimate) {
+  LoopResult result;
+  if (methods.empty()) return result;
+  Localizers localizers(map, methods, result);
+  std::optional<DelayedPose> controller_pose;
+  if (closed_loop) controller_pose.emplace(methods.front());
+  const auto handed_out = [&](const LocalizerEstimate& e) {
+    if (controller_pose) controller_pose->on_estimate(e);
+    if (on_estimate) on_estimate(e);
+  };
+  const auto t0 = Clock::now();
+  {
+    PipelinedSink sink(localizers, also, handed_out);
+    SimulationTap tap(sink, result.truth, result.scans, controller_pose ? &*controller_pose : nullptr);
+    if (controller_pose)
+      sim.set_pose_source([&](int64_t t_ns, const Pose2d& truth) { return controller_pose->pose(t_ns, truth); });
+    sim.run(tap, progress);
+    sim.set_pose_source({});
+    sink.finish();
+  }
+  result.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace lidarloop

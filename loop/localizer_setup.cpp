@@ -1,0 +1,52 @@
+#include "loop/localizer_setup.hpp"
+
+#include <stdexcept>
+
+#include "common/input_error.hpp"
+#include "loop/map_cache.hpp"
+
+namespace lidarloop {
+
+LoadedScenario load_scenario_and_world(const std::string& path) {
+  Scenario scenario = load_scenario(path, load_vehicle_params(data_dir() + "/assets/vehicle.yaml"));
+  LoadedWorld world = load_world(scenario.world);
+  ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
+  // The localizer section is the localizer's to check; do it now so that a typo fails before a run.
+  localizer_params_for(scenario);
+  return {std::move(scenario), std::move(world), std::move(resolved)};
+}
+
+HdMap open_scenario_map(const Scenario& scenario, const LoadedWorld& world) {
+  const MapLocation map = ensure_map(scenario.world, MappingOptions{}, false);
+  return open_hd_map(map.dir, world.description.name);
+}
+
+LocalizerParams localizer_params_for(const Scenario& s, const std::optional<std::string>& method) {
+  LocalizerParams p;
+  // The car's datasheet: what a real localizer is configured with.
+  const VehicleParams& v = s.ego.vehicle;
+  p.vehicle.cornering_stiffness_front = v.cornering_stiffness_front;
+  p.vehicle.cornering_stiffness_rear = v.cornering_stiffness_rear;
+  p.vehicle.lf = v.lf;
+  p.vehicle.lr = v.lr;
+  p.vehicle.yaw_inertia = v.yaw_inertia;
+  p.vehicle.mass = v.mass;
+  p.vehicle.steering_ratio = v.steering_ratio;
+  p.vehicle.kinematic_below = v.kinematic_below;
+  p.lidar_mount = s.lidar.mount();
+  p.seed = s.seed;
+  if (!s.text.empty()) {
+    const YamlReader y = YamlReader::from_string(s.text, s.file);
+    if (y.root().IsMap()) read_localizer_params(y, y.root()["localizer"], p);
+  }
+  if (method) {
+    try {
+      p.method = parse_localizer_method(*method);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(std::string("--method: ") + e.what());
+    }
+  }
+  return p;
+}
+
+}  // namespace lidarloop

@@ -1,0 +1,30 @@
+#pragma once
+// What every command that runs the localizer on a scenario needs: the scenario with its world, the
+// HD map of that world (built into the map cache the first time), and the localizer's parameters
+// (defaults, then the scenario's `localizer:` overrides, then the car's datasheet and LiDAR mount).
+#include <optional>
+#include <string>
+
+#include "localizer/hd_map.hpp"
+#include "localizer/localizer_params.hpp"
+#include "sim/scenario.hpp"
+#include "loop/world_assets.hpp"
+
+namespace lidarloop {
+
+struct LoadedScenario {
+  Scenario scenario;
+  LoadedWorld world;
+  ResolvedScenario resolved;
+};
+// InputError naming the file for anything wrong with the scenario or its world.
+LoadedScenario load_scenario_and_world(const std::string& path);
+
+// Finds or builds the map of the scenario's world (progress on a terminal) and opens it, checking
+// that it is the map of `world`.
+HdMap open_scenario_map(const Scenario& scenario, const LoadedWorld& world);
+
+// The localizer configuration of a scenario; `method` overrides the scenario's own.
+LocalizerParams localizer_params_for(const Scenario& scenario, const std::optional<std::string>& method = {});
+
+}  // namespace lidarloop

@@ -1,0 +1,240 @@
+#include "loop/result_files.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <numbers>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "common/input_error.hpp"
+#include "common/units.hpp"
+
+namespace lidarloop {
+
+namespace {
+
+using json = nlohmann::ordered_json;  // keys in the order written, for people reading the file
+
+constexpr int kJsonIndent = 2;
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw InputError(path + ": cannot open for writing");
+  out << text;
+  out.close();
+  if (!out) throw InputError(path + ": cannot write");
+}
+
+std::string format(const char* pattern, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, pattern, value);
+  return text;
+}
+
+// Full precision for machines; "nan" stays as it is (pandas and numpy read it).
+std::string number(double value) { return format("%.9g", value); }
+
+// Exact seconds from integer nanoseconds: no rounding through a double.
+std::string seconds(int64_t stamp_ns) {
+  const char* sign = stamp_ns < 0 ? "-" : "";
+  const int64_t magnitude = std::llabs(stamp_ns);
+  char text[48];
+  std::snprintf(text, sizeof text, "%s%lld.%09lld", sign, static_cast<long long>(magnitude / kNsPerS),
+                static_cast<long long>(magnitude % kNsPerS));
+  return text;
+}
+
+json finite_or_null(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+json optional_or_null(const std::optional<double>& value) { return value ? json(*value) : json(nullptr); }
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string quoted = "\"";
+  for (char c : s) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+std::string xml_escaped(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default:
+        // XML 1.0 forbids most control characters even when escaped.
+        out += (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') ? '?' : c;
+    }
+  }
+  return out;
+}
+
+std::string joined(const std::vector<std::string>& parts, const std::string& separator) {
+  std::string out;
+  for (size_t i = 0; i < parts.size(); ++i) out += (i ? separator : "") + parts[i];
+  return out;
+}
+
+std::string summary(const Metrics& m) {
+  return std::to_string(m.frames) + " frames; lateral RMSE " + format("%.3f", m.lateral_rmse_m) +
+         " m, longitudinal RMSE " + format("%.3f", m.longitudinal_rmse_m) + " m, heading RMSE " +
+         format("%.3f", m.heading_rmse_deg) + " deg, max position error " + format("%.3f", m.max_position_error_m) +
+         " m, latency p50 " + format("%.2f", m.latency_p50_ms) + " ms";
+}
+
+// For people: fixed decimals, "n/a" where there is no value.
+std::string cell(double value, const char* pattern) { return std::isfinite(value) ? format(pattern, value) : "n/a"; }
+
+std::string markdown_cell(std::string s) {
+  std::string out;
+  for (char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c);
+  return out;
+}
+
+}  // namespace
+
+std::string metrics_json(const Metrics& m) {
+  const json doc = {
+      {"method", m.method},
+      {"scenario", m.scenario},
+      {"frames", m.frames},
+      {"unscored_frames", m.unscored_frames},
+      {"settling_frames", m.settling_frames},
+      {"lateral_rmse_m", finite_or_null(m.lateral_rmse_m)},
+      {"longitudinal_rmse_m", finite_or_null(m.longitudinal_rmse_m)},
+      {"heading_rmse_deg", finite_or_null(m.heading_rmse_deg)},
+      {"position_rmse_m", finite_or_null(m.position_rmse_m)},
+      {"max_position_error_m", finite_or_null(m.max_position_error_m)},
+      {"max_lateral_m", finite_or_null(m.max_lateral_m)},
+      {"max_longitudinal_m", finite_or_null(m.max_longitudinal_m)},
+      {"max_heading_deg", finite_or_null(m.max_heading_deg)},
+      {"worst_frame_t_s", double(m.worst_frame_stamp_ns) / double(kNsPerS)},
+      {"latency_p50_ms", finite_or_null(m.latency_p50_ms)},
+      {"latency_p99_ms", finite_or_null(m.latency_p99_ms)},
+      {"latency_max_ms", finite_or_null(m.latency_max_ms)},
+      {"max_lane_offset_m", finite_or_null(m.max_lane_offset_m)},
+      {"thresholds",
+       {{"lateral_rmse_m", optional_or_null(m.thresholds.lateral_rmse_m)},
+        {"longitudinal_rmse_m", optional_or_null(m.thresholds.longitudinal_rmse_m)},
+        {"heading_rmse_deg", optional_or_null(m.thresholds.heading_rmse_deg)},
+        {"max_position_error_m", optional_or_null(m.thresholds.max_position_error_m)},
+        {"max_lane_offset_m", optional_or_null(m.thresholds.max_lane_offset_m)},
+        {"settle_s", m.thresholds.settle_s}}},
+      {"pass", m.pass},
+      {"failures", m.failures},
+  };
+  return doc.dump(kJsonIndent) + "\n";
+}
+
+void write_metrics_json(const std::string& path, const Metrics& metrics) { write_text_file(path, metrics_json(metrics)); }
+
+void write_errors_csv(const std::string& path, const ScoredRun& run, const std::vector<EstimateRecord>& estimates) {
+  std::string text =
+      "t_s,lateral_m,longitudinal_m,heading_deg,position_m,est_x_m,est_y_m,est_yaw_rad,truth_x_m,truth_y_m,"
+      "truth_yaw_rad,status,latency_ms,sigma_x_m,sigma_y_m,sigma_yaw_deg\n";
+  for (size_t i = 0; i < run.errors.size(); ++i) {
+    const FrameError& e = run.errors[i];
+    const EstimateRecord& est = estimates.at(run.estimate_index.at(i));
+    // A slightly negative variance from round-off is zero spread, not a NaN.
+    auto sigma = [&](int k) { return std::sqrt(std::max(0.0, est.covariance(k, k))); };
+    text += seconds(e.stamp_ns) + ',' + number(e.lateral_m) + ',' + number(e.longitudinal_m) + ',' +
+            number(e.heading_rad * kDegPerRad) + ',' + number(e.position_m) + ',' + number(e.estimate.x) + ',' +
+            number(e.estimate.y) + ',' + number(e.estimate.yaw) + ',' + number(e.truth.x) + ',' +
+            number(e.truth.y) + ',' + number(e.truth.yaw) + ',' + csv_field(est.status) + ',' +
+            number(est.latency_ms) + ',' + number(sigma(0)) + ',' + number(sigma(1)) + ',' +
+            number(sigma(2) * kDegPerRad) + '\n';
+  }
+  write_text_file(path, text);
+}
+
+std::string tum_line(int64_t stamp_ns, const Pose2d& pose) {
+  // A rotation by yaw about z: q = (0, 0, sin(yaw/2), cos(yaw/2)).
+  const double qz = std::sin(pose.yaw / 2), qw = std::cos(pose.yaw / 2);
+  return seconds(stamp_ns) + ' ' + number(pose.x) + ' ' + number(pose.y) + " 0 0 0 " + number(qz) + ' ' +
+         number(qw);
+}
+
+static const char* const kTumHeader = "# timestamp x y z qx qy qz qw\n";
+
+void write_tum(const std::string& path, const std::vector<TruthPose>& poses) {
+  std::string text = kTumHeader;
+  for (const auto& p : poses) text += tum_line(p.stamp_ns, p.pose) + '\n';
+  write_text_file(path, text);
+}
+
+void write_tum(const std::string& path, const std::vector<EstimateRecord>& estimates) {
+  std::string text = kTumHeader;
+  for (const auto& e : estimates) text += tum_line(e.stamp_ns, e.pose) + '\n';
+  write_text_file(path, text);
+}
+
+std::string junit_xml(const std::vector<Metrics>& runs) {
+  std::vector<std::string> scenarios;
+  for (const auto& m : runs)
+    if (std::find(scenarios.begin(), scenarios.end(), m.scenario) == scenarios.end()) scenarios.push_back(m.scenario);
+  size_t total_failures = 0;
+  for (const auto& m : runs) total_failures += m.pass ? 0 : 1;
+
+  std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  xml += "<testsuites name=\"lidarloop\" tests=\"" + std::to_string(runs.size()) + "\" failures=\"" +
+         std::to_string(total_failures) + "\">\n";
+  for (const auto& scenario : scenarios) {
+    size_t tests = 0, failures = 0;
+    for (const auto& m : runs)
+      if (m.scenario == scenario) tests++, failures += m.pass ? 0 : 1;
+    xml += "  <testsuite name=\"" + xml_escaped(scenario) + "\" tests=\"" + std::to_string(tests) +
+           "\" failures=\"" + std::to_string(failures) + "\" errors=\"0\">\n";
+    for (const auto& m : runs) {
+      if (m.scenario != scenario) continue;
+      xml += "    <testcase name=\"" + xml_escaped(m.method) + "\" classname=\"lidarloop." + xml_escaped(scenario) +
+             "\">\n";
+      if (!m.pass)
+        xml += "      <failure message=\"" + xml_escaped(joined(m.failures, "; ")) + "\" type=\"thresholds\">" +
+               xml_escaped(joined(m.failures, "\n")) + "</failure>\n";
+      xml += "      <system-out>" + xml_escaped(summary(m)) + "</system-out>\n";
+      xml += "    </testcase>\n";
+    }
+    xml += "  </testsuite>\n";
+  }
+  return xml + "</testsuites>\n";
+}
+
+void write_junit(const std::string& path, const std::vector<Metrics>& runs) { write_text_file(path, junit_xml(runs)); }
+
+std::string comparison_markdown(const std::vector<Metrics>& runs) {
+  bool several_scenarios = false;
+  for (const auto& m : runs) several_scenarios |= m.scenario != runs.front().scenario;
+  const std::string first = several_scenarios ? "| scenario " : "";
+  std::string md = first +
+                   "| method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | max error m | latency p50 ms | "
+                   "pass |\n" +
+                   (several_scenarios ? "|---" : "") + "|---|---:|---:|---:|---:|---:|:---:|\n";
+  for (const auto& m : runs) {
+    if (several_scenarios) md += "| " + markdown_cell(m.scenario) + ' ';
+    md += "| " + markdown_cell(m.method) + " | " + cell(m.lateral_rmse_m, "%.3f") + " | " +
+          cell(m.longitudinal_rmse_m, "%.3f") + " | " + cell(m.heading_rmse_deg, "%.3f") + " | " +
+          cell(m.max_position_error_m, "%.3f") + " | " + cell(m.latency_p50_ms, "%.2f") + " | " +
+          (m.pass ? "pass" : "FAIL") + " |\n";
+  }
+  return md;
+}
+
+void write_comparison_csv(const std::string& path, const std::vector<Metrics>& runs) {
+  std::string text =
+      "scenario,method,frames,lateral_rmse_m,longitudinal_rmse_m,heading_rmse_deg,max_position_error_m,"
+      "latency_p50_ms,latency_p99_ms,pass\n";
+  for (const auto& m : runs)
+    text += csv_field(m.scenario) + ',' + csv_field(m.method) + ',' + std::to_string(m.frames) + ',' +
+            number(m.lateral_rmse_m) + ',' + number(m.longitudinal_rmse_m) + ',' + number(m.heading_rmse_deg) + ',' +
+            number(m.max_position_error_m) + ',' + number(m.latency_p50_ms) + ',' + number(m.latency_p99_ms) + ',' +
+            (m.pass ? "true" : "false") + '\n';
+  write_text_file(path, text);
+}
+
+}  // namespace lidarloop

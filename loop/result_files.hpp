@@ -1,0 +1,39 @@
+#pragma once
+// The files a run leaves behind (DESIGN.md "Files": results): metrics.json for machines, errors.csv
+// per frame, TUM trajectories for evo, JUnit XML for CI, and the comparison table of `lidarloop
+// compare` (markdown for people, CSV for spreadsheets). Every writer throws InputError naming the
+// path when the file cannot be written.
+#include <string>
+#include <vector>
+
+#include "loop/scorer.hpp"
+
+namespace lidarloop {
+
+// metrics.json: every Metrics field (thresholds as an object, unset ones null; undefined values such
+// as the RMSE of zero frames are null too, since JSON has no NaN).
+std::string metrics_json(const Metrics& metrics);
+void write_metrics_json(const std::string& path, const Metrics& metrics);
+
+// errors.csv: one line per scored estimate: time, the errors (heading in degrees: this file is read
+// by people and plotting scripts), both poses, the estimate's status, latency and standard deviations.
+void write_errors_csv(const std::string& path, const ScoredRun& run, const std::vector<EstimateRecord>& estimates);
+
+// TUM trajectory for evo: `t x y z qx qy qz qw`, t in seconds, 9 significant digits, z = 0, the yaw
+// as a rotation about z.
+std::string tum_line(int64_t stamp_ns, const Pose2d& pose);
+void write_tum(const std::string& path, const std::vector<TruthPose>& poses);
+void write_tum(const std::string& path, const std::vector<EstimateRecord>& estimates);
+
+// JUnit XML: one testsuite per scenario (in first-seen order), one testcase per method, with a
+// <failure> when the method failed its thresholds.
+std::string junit_xml(const std::vector<Metrics>& runs);
+void write_junit(const std::string& path, const std::vector<Metrics>& runs);
+
+// Like the paper's Table III: method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg |
+// max error m | latency p50 ms | pass. A scenario column is added when the runs span several.
+std::string comparison_markdown(const std::vector<Metrics>& runs);
+// The same columns (and always the scenario) with full precision.
+void write_comparison_csv(const std::string& path, const std::vector<Metrics>& runs);
+
+}  // namespace lidarloop

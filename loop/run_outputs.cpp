@@ -1,0 +1,83 @@
+#include "loop/run_outputs.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "localizer/driving_corridor.hpp"
+#include "loop/birdseye.hpp"
+#include "loop/error_plots.hpp"
+#include "loop/result_files.hpp"
+
+namespace lidarloop {
+namespace {
+
+void write_worst_frame(const std::string& path, const WorstFrame& w, const HdMap& map, const std::string& method) {
+  if (w.error_m < 0) return;
+  auto place = [&](const std::vector<Eigen::Vector2d>& vehicle_points) {
+    std::vector<Eigen::Vector2d> world;
+    for (const auto& p : vehicle_points) world.push_back(vehicle_to_world(w.estimate, p));
+    return world;
+  };
+  BirdseyeOptions o;
+  std::ostringstream title;
+  title.precision(2);
+  title << std::fixed << method << ": worst frame, position error " << w.error_m << " m";
+  o.title = title.str();
+  o.marks = {{"curb features (placed at the estimate)", place(w.features.curbs), {0, 0, 255}},
+             {"obstacle points (placed at the estimate)", place(w.features.obstacles), {255, 0, 255}}};
+  o.poses = {{"ground truth", w.truth, {255, 255, 255}}, {"estimate", w.estimate, {0, 200, 255}}};
+  write_birdseye_png(path, w.cloud, w.sensor_pose, map.curbs.map().curbs, o);
+}
+
+}  // namespace
+
+std::vector<TruthPose> truth_poses(const std::vector<TruthSample>& truth) {
+  std::vector<TruthPose> out;
+  out.reserve(truth.size());
+  for (const auto& t : truth) out.push_back({t.stamp_ns, t.pose});
+  return out;
+}
+
+std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate>& estimates) {
+  std::vector<EstimateRecord> out;
+  out.reserve(estimates.size());
+  for (const auto& e : estimates)
+    if (!(e.health & kNotInitialized))
+      out.push_back({e.stamp_ns, e.pose, e.covariance, describe_health(e.health), e.total_ms});
+  return out;
+}
+
+double max_lane_offset(const std::vector<TruthSample>& truth, const Path& route) {
+  double worst = 0, s = 0;
+  constexpr double kSearch = 30.0;  // m along the route around the previous projection
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const Eigen::Vector2d p(truth[i].pose.x, truth[i].pose.y);
+    s = i == 0 ? route.project(p) : route.project(p, std::max(0.0, s - kSearch), std::min(route.length, s + kSearch));
+    const Pose2d on = route.pose_at(s);
+    worst = std::max(worst, std::abs(-std::sin(on.yaw) * (p.x() - on.x) + std::cos(on.yaw) * (p.y() - on.y)));
+  }
+  return worst;
+}
+
+ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
+                          const Path& route, const std::vector<TruthSample>& truth_samples, const std::string& method,
+                          const std::vector<LocalizerEstimate>& all_estimates, const WorstFrame* worst,
+                          const HdMap& map) {
+  std::filesystem::create_directories(dir);
+  const std::vector<EstimateRecord> estimates = estimate_records(all_estimates);
+  const std::vector<TruthPose> truth = truth_poses(truth_samples);
+  ScoredRun scored = score(truth, estimates, scenario.pass, method, scenario_name);
+  score_lane_keeping(scored.metrics, max_lane_offset(truth_samples, route));
+  write_metrics_json(dir + "/metrics.json", scored.metrics);
+  write_errors_csv(dir + "/errors.csv", scored, estimates);
+  write_tum(dir + "/estimate.tum", estimates);
+  write_tum(dir + "/truth.tum", truth);
+  write_junit(dir + "/junit.xml", {scored.metrics});
+  write_error_plot(dir + "/errors.png", scored.errors);
+  write_trajectory_plot(dir + "/trajectory.png", truth, estimates, scored.errors, map.curbs.map().curbs);
+  if (worst) write_worst_frame(dir + "/worst_frame.png", *worst, map, method);
+  return scored;
+}
+
+}  // namespace lidarloop

@@ -1,0 +1,26 @@
+#pragma once
+// What `run`, `compare` and `replay` leave in their output folder, written the same way by each:
+// metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and the plots (Fig. 11, 13, 14).
+#include <string>
+#include <vector>
+
+#include "localizer/hd_map.hpp"
+#include "loop/localizer_loop.hpp"
+#include "loop/scorer.hpp"
+
+namespace lidarloop {
+
+std::vector<TruthPose> truth_poses(const std::vector<TruthSample>& truth);
+// Estimates of an initialised localizer, with the health as words and the latency.
+std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate>& estimates);
+
+// The true pose's largest distance from the lane centre the ego was told to follow.
+double max_lane_offset(const std::vector<TruthSample>& truth, const Path& route);
+
+// Scores one method's run (thresholds, settle time and lane keeping from the scenario) and writes its
+// files into `dir`. `worst` may be null (no bird's-eye picture).
+ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
+                          const Path& route, const std::vector<TruthSample>& truth, const std::string& method,
+                          const std::vector<LocalizerEstimate>& estimates, const WorstFrame* worst, const HdMap& map);
+
+}  // namespace lidarloop

@@ -1,0 +1,33 @@
+#include "loop/run_recording.hpp"
+
+#include "common/input_error.hpp"
+#include "loop/map_cache.hpp"
+
+namespace lidarloop {
+
+void RecordingSink::on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) {
+  std::vector<ros2::ActorState> states;
+  states.reserve(actors.size());
+  for (const auto& a : actors) states.push_back({a.name, actor_type_name(a.type), a.pose});
+  log_.write_actors(stamp_ns, states);
+}
+
+std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>& path, const Scenario& scenario,
+                                               const std::string& method) {
+  if (!path) return nullptr;
+  if (path->empty()) throw InputError("--record: needs a file name");
+  auto recorder = std::make_unique<RecordingSink>(*path, scenario.lidar.mount());
+  McapRecorder& log = recorder->log();
+  log.add_attachment(kScenarioAttachment, "application/yaml", scenario.text);
+  log.add_metadata(kRunMetadata, {{"scenario", scenario.file},
+                                        {"world", scenario.world},
+                                        {"seed", std::to_string(scenario.seed)},
+                                        {"duration_s", std::to_string(scenario.duration_s)},
+                                        {"method", method},
+                                        {"loop", scenario.closed_loop ? "closed" : "open"},
+                                        {"map_hash", map_hash(scenario.world, MappingOptions{})},
+                                        {"version", LIDARLOOP_VERSION}});
+  return recorder;
+}
+
+}  // namespace lidarloop

@@ -1,0 +1,61 @@
+#pragma once
+// `--record FILE.mcap`: a run's streams as an MCAP log, with what replay needs to redo the run
+// exactly: the scenario YAML as an attachment, and the seed, method and map as metadata.
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "logs/mcap_recorder.hpp"
+#include "sim/scenario.hpp"
+#include "sim/simulation.hpp"
+
+namespace lidarloop {
+
+inline constexpr const char* kScenarioAttachment = "scenario.yaml";
+inline constexpr const char* kRunMetadata = "lidarloop.run";
+
+// Passes every stream to two sinks (files and a recorder).
+class TeeSink : public StreamSink {
+ public:
+  TeeSink(StreamSink& a, StreamSink* b) : a_(a), b_(b) {}
+  void on_truth(const TruthSample& t) override { a_.on_truth(t); if (b_) b_->on_truth(t); }
+  void on_can(const CanFrame& f) override { a_.on_can(f); if (b_) b_->on_can(f); }
+  void on_gps(const GpsFix& f) override { a_.on_gps(f); if (b_) b_->on_gps(f); }
+  void on_rtk(const GpsFix& f) override { a_.on_rtk(f); if (b_) b_->on_rtk(f); }
+  void on_scan(const PointCloud& c, const Eigen::Isometry3d& pose) override {
+    a_.on_scan(c, pose);
+    if (b_) b_->on_scan(c, pose);
+  }
+  void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override {
+    a_.on_actors(stamp_ns, actors);
+    if (b_) b_->on_actors(stamp_ns, actors);
+  }
+
+ private:
+  StreamSink& a_;
+  StreamSink* b_;
+};
+
+// The simulator's streams into an MCAP log (logs/ knows messages, not the simulator).
+class RecordingSink : public StreamSink {
+ public:
+  RecordingSink(const std::string& path, const Eigen::Isometry3d& lidar_mount) : log_(path, lidar_mount) {}
+  void on_truth(const TruthSample& t) override { log_.write_truth(t); }
+  void on_can(const CanFrame& f) override { log_.write_can(f); }
+  void on_gps(const GpsFix& f) override { log_.write_gps(f); }
+  void on_rtk(const GpsFix& f) override { log_.write_rtk(f); }
+  // The sensor pose is not logged separately: /tf (truth) and /tf_static (mount) give it.
+  void on_scan(const PointCloud& c, const Eigen::Isometry3d&) override { log_.write_scan(c); }
+  void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override;
+
+  McapRecorder& log() { return log_; }
+
+ private:
+  McapRecorder log_;
+};
+
+// Null when `path` is empty. `method` is the localizer's, empty for `simulate`.
+std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>& path, const Scenario& scenario,
+                                              const std::string& method);
+
+}  // namespace lidarloop

@@ -1,0 +1,149 @@
+#include "loop/scorer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+
+#include "common/units.hpp"
+#include "common/pose2d.hpp"
+
+namespace lidarloop {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kMedianPercent = 50.0;
+constexpr double kTailPercent = 99.0;
+
+// "lateral RMSE 0.310 m > 0.200 m". Millimetre (millidegree) digits so a value just over its
+// threshold never prints as equal to it.
+std::string failure(const char* what, double value, double threshold, const char* unit) {
+  char text[128];
+  std::snprintf(text, sizeof text, "%s %.3f %s > %.3f %s", what, value, unit, threshold, unit);
+  return text;
+}
+
+void check(Metrics& m, const char* what, double value, const std::optional<double>& threshold, const char* unit) {
+  // Written as !(value <= threshold) so that NaN (a diverged estimate) fails instead of passing.
+  if (threshold && !(value <= *threshold)) m.failures.push_back(failure(what, value, *threshold, unit));
+}
+
+}  // namespace
+
+FrameError frame_error(const Pose2d& truth, const Pose2d& estimate) {
+  const double dx = estimate.x - truth.x, dy = estimate.y - truth.y;
+  const double c = std::cos(truth.yaw), s = std::sin(truth.yaw);
+  FrameError e;
+  e.longitudinal_m = c * dx + s * dy;
+  e.lateral_m = -s * dx + c * dy;
+  e.heading_rad = wrap_angle(estimate.yaw - truth.yaw);
+  e.position_m = std::hypot(dx, dy);
+  e.truth = truth;
+  e.estimate = estimate;
+  return e;
+}
+
+Pose2d truth_at(const std::vector<TruthPose>& truth, int64_t t_ns) {
+  if (truth.empty()) throw std::out_of_range("truth_at: no ground truth");
+  if (t_ns < truth.front().stamp_ns || t_ns > truth.back().stamp_ns)
+    throw std::out_of_range("truth_at: t = " + std::to_string(t_ns) + " ns is outside the ground truth's range [" +
+                            std::to_string(truth.front().stamp_ns) + ", " + std::to_string(truth.back().stamp_ns) +
+                            "] ns");
+  // The first sample after t; the one before it is at or before t.
+  const auto after = std::upper_bound(truth.begin(), truth.end(), t_ns,
+                                      [](int64_t t, const TruthPose& p) { return t < p.stamp_ns; });
+  if (after == truth.end()) return truth.back().pose;  // t is the last stamp
+  const TruthPose& a = *(after - 1);
+  const TruthPose& b = *after;
+  const double f = double(t_ns - a.stamp_ns) / double(b.stamp_ns - a.stamp_ns);
+  return {a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y),
+          wrap_angle(a.pose.yaw + f * wrap_angle(b.pose.yaw - a.pose.yaw))};
+}
+
+double rmse(const std::vector<double>& values) {
+  if (values.empty()) return kNaN;
+  double sum = 0;
+  for (double v : values) sum += v * v;
+  return std::sqrt(sum / double(values.size()));
+}
+
+double percentile_nearest_rank(std::vector<double> values, double percent) {
+  if (values.empty()) return kNaN;
+  std::sort(values.begin(), values.end());
+  const double rank = std::ceil(percent / 100.0 * double(values.size()));
+  const size_t index = size_t(std::clamp(rank, 1.0, double(values.size()))) - 1;
+  return values[index];
+}
+
+ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates,
+                const PassThresholds& thresholds, const std::string& method, const std::string& scenario) {
+  if (!std::is_sorted(truth.begin(), truth.end(),
+                      [](const TruthPose& a, const TruthPose& b) { return a.stamp_ns < b.stamp_ns; }))
+    throw std::invalid_argument("score: ground truth is not sorted by stamp");
+  ScoredRun run;
+  Metrics& m = run.metrics;
+  m.method = method;
+  m.scenario = scenario;
+  m.thresholds = thresholds;
+
+  std::vector<double> lateral, longitudinal, heading_deg, position, latency;
+  for (size_t i = 0; i < estimates.size(); ++i) {
+    const EstimateRecord& est = estimates[i];
+    latency.push_back(est.latency_ms);
+    if (truth.empty() || est.stamp_ns < truth.front().stamp_ns || est.stamp_ns > truth.back().stamp_ns) {
+      ++m.unscored_frames;
+      continue;
+    }
+    if (double(est.stamp_ns - estimates.front().stamp_ns) < thresholds.settle_s * 1e9) {
+      ++m.settling_frames;
+      continue;
+    }
+    FrameError e = frame_error(truth_at(truth, est.stamp_ns), est.pose);
+    e.stamp_ns = est.stamp_ns;
+    lateral.push_back(e.lateral_m);
+    longitudinal.push_back(e.longitudinal_m);
+    heading_deg.push_back(e.heading_rad * kDegPerRad);
+    position.push_back(e.position_m);
+    // `!(a <= b)` so a NaN error becomes the worst frame rather than being skipped.
+    if (run.errors.empty() || !(e.position_m <= m.max_position_error_m)) {
+      m.max_position_error_m = e.position_m;
+      m.worst_frame_stamp_ns = e.stamp_ns;
+    }
+    m.max_lateral_m = std::max(m.max_lateral_m, std::abs(e.lateral_m));
+    m.max_longitudinal_m = std::max(m.max_longitudinal_m, std::abs(e.longitudinal_m));
+    m.max_heading_deg = std::max(m.max_heading_deg, std::abs(e.heading_rad) * kDegPerRad);
+    run.errors.push_back(e);
+    run.estimate_index.push_back(i);
+  }
+  m.frames = run.errors.size();
+  m.lateral_rmse_m = rmse(lateral);
+  m.longitudinal_rmse_m = rmse(longitudinal);
+  m.heading_rmse_deg = rmse(heading_deg);
+  m.position_rmse_m = rmse(position);
+  m.latency_p50_ms = percentile_nearest_rank(latency, kMedianPercent);
+  m.latency_p99_ms = percentile_nearest_rank(latency, kTailPercent);
+  m.latency_max_ms = latency.empty() ? kNaN : *std::max_element(latency.begin(), latency.end());
+  if (m.frames == 0) {
+    m.max_position_error_m = m.max_lateral_m = m.max_longitudinal_m = m.max_heading_deg = kNaN;
+    m.failures.push_back(estimates.empty() ? "no estimates" : "no estimates within the ground truth's time range");
+  } else {
+    check(m, "lateral RMSE", m.lateral_rmse_m, thresholds.lateral_rmse_m, "m");
+    check(m, "longitudinal RMSE", m.longitudinal_rmse_m, thresholds.longitudinal_rmse_m, "m");
+    check(m, "heading RMSE", m.heading_rmse_deg, thresholds.heading_rmse_deg, "deg");
+    check(m, "max position error", m.max_position_error_m, thresholds.max_position_error_m, "m");
+  }
+  m.pass = m.failures.empty();
+  return run;
+}
+
+void score_lane_keeping(Metrics& m, double max_lane_offset_m) {
+  m.max_lane_offset_m = max_lane_offset_m;
+  check(m, "lane offset", max_lane_offset_m, m.thresholds.max_lane_offset_m, "m");
+  m.pass = m.failures.empty();
+}
+
+}  // namespace lidarloop

@@ -1,0 +1,41 @@
+#include "loop/world_assets.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "common/input_error.hpp"
+#include "sim/path.hpp"
+
+namespace lidarloop {
+
+std::string data_dir() {
+  if (const char* env = std::getenv("LIDARLOOP_DATA"); env && *env) return env;
+  return LIDARLOOP_DATA_DIR;
+}
+
+std::string actors_dir() { return data_dir() + "/assets/actors"; }
+
+std::string world_file(const std::string& name_or_path) {
+  namespace fs = std::filesystem;
+  if (name_or_path.find('/') != std::string::npos || fs::path(name_or_path).extension() == ".yaml") {
+    if (!fs::is_regular_file(name_or_path)) throw InputError(name_or_path + ": no such world file");
+    return name_or_path;
+  }
+  const std::string path = data_dir() + "/maps/" + name_or_path + "/world.yaml";
+  if (!fs::is_regular_file(path))
+    throw InputError("unknown world '" + name_or_path + "': " + path + " does not exist");
+  return path;
+}
+
+LoadedWorld load_world(const std::string& name_or_path) {
+  MaterialTable materials = MaterialTable::load(data_dir() + "/assets/materials.yaml");
+  WorldDescription description = load_world_description(world_file(name_or_path));
+  World world = build_world(description, materials, actors_dir());
+  return {std::move(materials), std::move(description), std::move(world)};
+}
+
+Eigen::Isometry3d default_start_pose(const WorldDescription& description, double s) {
+  return to_isometry(lane_path(description.roads.front(), Lane::right, false).pose_at(s));
+}
+
+}  // namespace lidarloop
