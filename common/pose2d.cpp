@@ -16,8 +16,8 @@ Eigen::Vector2d Pose2d::apply(const Eigen::Vector2d& p) const {
 }
 
 Pose2d Pose2d::compose(const Pose2d& b) const {
-  const Eigen::Vector2d t = apply({b.x, b.y});
-  return {t.x(), t.y(), wrap_angle(yaw + b.yaw)};
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  return {x + c * b.x - s * b.y, y + s * b.x + c * b.y, wrap_angle(yaw + b.yaw)};
 }
 
 Pose2d Pose2d::inverse() const {

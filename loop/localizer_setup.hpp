@@ -8,7 +8,7 @@
 #include "localizer/hd_map.hpp"
 #include "localizer/localizer_params.hpp"
 #include "sim/scenario.hpp"
-#include "loop/world_assets.hpp"
+#include "sim/world_assets.hpp"
 
 namespace lidarloop {
 

@@ -11,7 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/input_error.hpp"
-#include "loop/world_assets.hpp"
+#include "sim/world_assets.hpp"
 
 namespace lidarloop {
 

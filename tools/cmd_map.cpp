@@ -12,7 +12,7 @@
 #include "tools/commands.hpp"
 #include "loop/map_cache.hpp"
 #include "tools/scene_setup.hpp"
-#include "loop/world_assets.hpp"
+#include "sim/world_assets.hpp"
 
 namespace lidarloop {
 

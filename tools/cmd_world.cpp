@@ -4,7 +4,7 @@
 
 #include "sim/obj_file.hpp"
 #include "tools/commands.hpp"
-#include "loop/world_assets.hpp"
+#include "sim/world_assets.hpp"
 #include "tools/world_map_png.hpp"
 
 namespace lidarloop {

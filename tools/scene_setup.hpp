@@ -9,7 +9,7 @@
 #include "sim/actor_assets.hpp"
 #include "sim/lidar_scanner.hpp"
 #include "sim/traffic.hpp"
-#include "loop/world_assets.hpp"
+#include "sim/world_assets.hpp"
 
 namespace lidarloop {
 

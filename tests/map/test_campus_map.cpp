@@ -8,7 +8,7 @@
 #include "localizer/hd_map.hpp"
 #include "sim/ray_scene.hpp"
 #include "loop/map_cache.hpp"
-#include "loop/world_assets.hpp"
+#include "sim/world_assets.hpp"
 
 namespace lidarloop {
 namespace {

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/input_error.hpp"
-#include "../mcap_fixture.hpp"
+#include "../logs/mcap_fixture.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 

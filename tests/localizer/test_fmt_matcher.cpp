@@ -12,12 +12,12 @@
 
 #include <Eigen/Core>
 
+#include "common/units.hpp"
 #include "localizer/fmt_matcher.hpp"
 
 namespace lidarloop {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kSpacing = 0.1;  // m between map curb points (the map's resolution)
 
 // The junction sits far from the local origin, so a rotation about the wrong point shows.
@@ -55,14 +55,14 @@ std::vector<Eigen::Vector2d> junction_map() {
 // A pose error of the prior, as the correction that undoes it: turn by `theta` about the true vehicle
 // position, then shift by (x, y). The prior is then |(x, y)| from the truth, as after a GPS error, and
 // the map window around the prior still covers the junction whatever the heading error.
-Transform2d correction_about_vehicle(double x, double y, double theta) {
+Pose2d correction_about_vehicle(double x, double y, double theta) {
   const Eigen::Vector2d v = kOrigin + kVehicle;
-  const Transform2d to_vehicle{-v.x(), -v.y(), 0}, turn{0, 0, theta}, back{v.x() + x, v.y() + y, 0};
+  const Pose2d to_vehicle{-v.x(), -v.y(), 0}, turn{0, 0, theta}, back{v.x() + x, v.y() + y, 0};
   return back.compose(turn.compose(to_vehicle));
 }
 
 struct Case {
-  Transform2d correction;                    // what fmt_match should find
+  Pose2d correction;                    // what fmt_match should find
   std::vector<Eigen::Vector2d> curbs_world;  // detected curbs placed in the world at the prior pose
   Eigen::Vector2d prior;                     // the prior position: the grid centre
   Eigen::Vector2d truth;                     // where the correction must take the prior
@@ -75,7 +75,7 @@ Case make_case(const std::vector<Eigen::Vector2d>& map, double x, double y, doub
   std::normal_distribution<double> noise(0.0, kCurbNoise);
   Case c;
   c.correction = correction_about_vehicle(x, y, theta);
-  const Transform2d to_prior = c.correction.inverse();
+  const Pose2d to_prior = c.correction.inverse();
   c.truth = kOrigin + kVehicle;
   c.prior = to_prior.apply(c.truth);
   for (size_t i = 0; i < map.size(); i += kScanStride) {
@@ -92,8 +92,8 @@ void expect_recovered(const FmtResult& r, const Case& c) {
   const Eigen::Vector2d corrected = r.correction.apply(c.prior);
   EXPECT_NEAR(corrected.x(), c.truth.x(), kPositionTolerance);
   EXPECT_NEAR(corrected.y(), c.truth.y(), kPositionTolerance);
-  EXPECT_NEAR(wrap_angle(r.correction.theta - c.correction.theta), 0.0, kHeadingTolerance)
-      << "heading " << r.correction.theta / kDeg << " deg";
+  EXPECT_NEAR(wrap_angle(r.correction.yaw - c.correction.yaw), 0.0, kHeadingTolerance)
+      << "heading " << r.correction.yaw / kDeg << " deg";
   const Eigen::Vector2d far_curb = c.prior + Eigen::Vector2d(kScanRange, 0);
   EXPECT_LT((r.correction.apply(far_curb) - c.correction.apply(far_curb)).norm(), 2 * kPositionTolerance);
 }
@@ -117,7 +117,7 @@ TEST(FmtMatcher, RecoversPureTranslationToOneCell) {
   const Eigen::Vector2d moved = r.correction.apply(c.prior) - c.prior;
   EXPECT_NEAR(moved.x(), 1.3, cell);
   EXPECT_NEAR(moved.y(), -0.7, cell);
-  EXPECT_NEAR(r.correction.theta, 0.0, kHeadingTolerance);
+  EXPECT_NEAR(r.correction.yaw, 0.0, kHeadingTolerance);
 }
 
 // Each axis and each sense of rotation on its own: a swapped x and y, a row direction taken as +y, or
@@ -125,18 +125,18 @@ TEST(FmtMatcher, RecoversPureTranslationToOneCell) {
 TEST(FmtMatcher, SignConventions) {
   const auto map = junction_map();
   constexpr double kShift = 0.8, kTurn = 3.0 * kDeg;
-  struct Error { double x, y, theta; };
+  struct Error { double x, y, yaw; };
   for (const Error e : {Error{kShift, 0, 0}, Error{0, kShift, 0}, Error{0, 0, kTurn}, Error{0, 0, -kTurn}}) {
-    SCOPED_TRACE(testing::Message() << "error " << e.x << " m, " << e.y << " m, " << e.theta / kDeg << " deg");
-    const Case c = make_case(map, e.x, e.y, e.theta);
+    SCOPED_TRACE(testing::Message() << "error " << e.x << " m, " << e.y << " m, " << e.yaw / kDeg << " deg");
+    const Case c = make_case(map, e.x, e.y, e.yaw);
     const FmtResult r = fmt_match(c.curbs_world, map, c.prior);
     expect_recovered(r, c);
-    if (e.theta == 0) {  // a pure shift: the pose must move by it, in this direction
+    if (e.yaw == 0) {  // a pure shift: the pose must move by it, in this direction
       const Eigen::Vector2d moved = r.correction.apply(c.prior) - c.prior;
       EXPECT_NEAR(moved.x(), e.x, kPositionTolerance);
       EXPECT_NEAR(moved.y(), e.y, kPositionTolerance);
     } else {
-      EXPECT_GT(r.correction.theta * e.theta, 0) << "rotation read the wrong way round";
+      EXPECT_GT(r.correction.yaw * e.yaw, 0) << "rotation read the wrong way round";
     }
   }
 }
@@ -167,8 +167,8 @@ TEST(FmtMatcher, RefusesEmptyAndNonFiniteInput) {
   // Degenerate but finite input: an answer, finite whatever it is.
   const std::vector<Eigen::Vector2d> one_spot(50, c.prior), one_line(map.begin(), map.begin() + 200);
   for (const auto* curbs : {&one_spot, &one_line}) {
-    const Transform2d t = fmt_match(*curbs, map, c.prior).correction;
-    EXPECT_TRUE(std::isfinite(t.x) && std::isfinite(t.y) && std::isfinite(t.theta));
+    const Pose2d t = fmt_match(*curbs, map, c.prior).correction;
+    EXPECT_TRUE(std::isfinite(t.x) && std::isfinite(t.y) && std::isfinite(t.yaw));
   }
 
   // A few non-finite curbs among good ones are skipped, not fatal.

@@ -19,9 +19,9 @@ TEST(CurbFeatures, FramesStackOnTheTrueCurbWithKnownOdometry) {
   double heading = 0;
   for (int frame = 0; frame < 8; ++frame) {
     // Motion since the previous frame, in the previous vehicle frame.
-    const Odometry2d step{frame == 0 ? 0.0 : 1.0, frame == 0 ? 0.0 : 0.05, frame == 0 ? 0.0 : 0.01};
-    position += Eigen::Rotation2D<double>(heading) * Eigen::Vector2d(step.dx, step.dy);
-    heading += step.dpsi;
+    const Pose2d step{frame == 0 ? 0.0 : 1.0, frame == 0 ? 0.0 : 0.05, frame == 0 ? 0.0 : 0.01};
+    position += Eigen::Rotation2D<double>(heading) * Eigen::Vector2d(step.x, step.y);
+    heading += step.yaw;
     // This frame's detections: points of the curb within 15 m, seen in the vehicle frame.
     std::vector<Eigen::Vector2d> seen;
     for (double x = position.x() - 15; x < position.x() + 15; x += 0.5) {

@@ -5,7 +5,7 @@
 
 #include "sim/simulation.hpp"
 #include "test_support.hpp"
-#include "loop/world_assets.hpp"
+#include "sim/world_assets.hpp"
 
 namespace lidarloop {
 namespace {

@@ -7,13 +7,13 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include "common/units.hpp"
 #include "sim/lidar_scanner.hpp"
 #include "test_support.hpp"
 
 namespace lidarloop {
 namespace {
 
-constexpr double kDeg = M_PI / 180;
 // Velodyne HDL-32E user manual, vertical angles by laser from lowest to highest.
 constexpr double kDatasheetElevation[32] = {-30.67, -29.33, -28.00, -26.67, -25.33, -24.00, -22.67, -21.33,
                                             -20.00, -18.67, -17.33, -16.00, -14.67, -13.33, -12.00, -10.67,

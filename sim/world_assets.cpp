@@ -1,4 +1,4 @@
-#include "loop/world_assets.hpp"
+#include "sim/world_assets.hpp"
 
 #include <cstdlib>
 #include <filesystem>

@@ -8,7 +8,7 @@
 #include "sim/lidar_scanner.hpp"
 #include "sim/polyline.hpp"
 #include "test_support.hpp"
-#include "loop/world_assets.hpp"
+#include "sim/world_assets.hpp"
 
 namespace lidarloop {
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-// Finding and building the worlds and assets the CLI works with.
+// Finding and building the worlds and assets: by name under maps/ and assets/, or by path.
 #include <string>
 
 #include "sim/materials.hpp"
