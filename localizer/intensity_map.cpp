@@ -17,6 +17,7 @@
 
 #include "common/crc32.hpp"
 #include "common/input_error.hpp"
+#include "common/little_endian.hpp"
 #include "common/yaml_reader.hpp"
 
 namespace lidarloop {
@@ -53,22 +54,11 @@ constexpr const char* kTempSuffix = ".tmp";
 // physical distance.
 constexpr double kBoundarySnapUlps = 64;
 
-constexpr size_t kBitsPerByte = 8;
-constexpr uint32_t kLowByte = 0xFFu;
-
-// Explicit little-endian bytes, so files are the same on any host.
-void put_u32(std::string& out, uint32_t v) {
-  for (size_t i = 0; i < sizeof v; ++i) out.push_back(static_cast<char>((v >> (kBitsPerByte * i)) & kLowByte));
-}
+void put_u32(std::string& out, uint32_t v) { append_le(out, v, sizeof v); }
 void put_i32(std::string& out, int32_t v) { put_u32(out, static_cast<uint32_t>(v)); }
 void put_f32(std::string& out, float v) { put_u32(out, std::bit_cast<uint32_t>(v)); }
 
-uint32_t get_u32(const std::string& in, size_t offset) {
-  uint32_t v = 0;
-  for (size_t i = 0; i < sizeof v; ++i)
-    v |= uint32_t(static_cast<unsigned char>(in[offset + i])) << (kBitsPerByte * i);
-  return v;
-}
+uint32_t get_u32(const std::string& in, size_t offset) { return uint32_t(get_le(in.data() + offset, sizeof(uint32_t))); }
 int32_t get_i32(const std::string& in, size_t offset) { return static_cast<int32_t>(get_u32(in, offset)); }
 float get_f32(const std::string& in, size_t offset) { return std::bit_cast<float>(get_u32(in, offset)); }
 

@@ -1,5 +1,7 @@
 #include "logs/mcap/byte_io.hpp"
 
+#include <stdexcept>
+
 #include "common/input_error.hpp"
 
 namespace lidarloop {
@@ -19,12 +21,9 @@ void ByteWriter::string_map(const std::map<std::string, std::string>& m) {
   patch_u32(start, uint32_t(size() - start - 4));
 }
 
-void ByteWriter::patch_u32(size_t pos, uint32_t v) {
-  for (int i = 0; i < 4; ++i) buf_.at(pos + size_t(i)) = uint8_t(v >> (8 * i));
-}
-
-void ByteWriter::patch_u64(size_t pos, uint64_t v) {
-  for (int i = 0; i < 8; ++i) buf_.at(pos + size_t(i)) = uint8_t(v >> (8 * i));
+void ByteWriter::patch(size_t pos, uint64_t v, int n) {
+  if (pos + size_t(n) > buf_.size()) throw std::out_of_range("ByteWriter::patch: past the end of the buffer");
+  put_le(buf_.data() + pos, v, n);
 }
 
 void ByteReader::fail(const std::string& problem) const {
@@ -33,8 +32,7 @@ void ByteReader::fail(const std::string& problem) const {
 
 uint64_t ByteReader::le(int n, const char* what) {
   if (remaining() < size_t(n)) fail(std::string(what) + " truncated");
-  uint64_t v = 0;
-  for (int i = 0; i < n; ++i) v |= uint64_t(data_[pos_ + size_t(i)]) << (8 * i);
+  const uint64_t v = get_le(data_.data() + pos_, n);
   pos_ += size_t(n);
   return v;
 }

@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "common/little_endian.hpp"
+
 namespace lidarloop {
 
 class ByteWriter {
@@ -23,17 +25,16 @@ class ByteWriter {
   void string_map(const std::map<std::string, std::string>& m);  // uint32 byte length + key/value strings
 
   // Overwrites 4 or 8 bytes at `pos`, for length prefixes known only after their content.
-  void patch_u32(size_t pos, uint32_t v);
-  void patch_u64(size_t pos, uint64_t v);
+  void patch_u32(size_t pos, uint32_t v) { patch(pos, v, 4); }
+  void patch_u64(size_t pos, uint64_t v) { patch(pos, v, 8); }
 
   size_t size() const { return buf_.size(); }
   std::vector<uint8_t>& buffer() { return buf_; }
   const std::vector<uint8_t>& buffer() const { return buf_; }
 
  private:
-  void le(uint64_t v, int n) {
-    for (int i = 0; i < n; ++i) buf_.push_back(uint8_t(v >> (8 * i)));
-  }
+  void le(uint64_t v, int n) { append_le(buf_, v, n); }
+  void patch(size_t pos, uint64_t v, int n);
   std::vector<uint8_t> buf_;
 };
 
