@@ -10,22 +10,38 @@ case "$what" in run|test) ;; *) echo "usage: tools/quickstart.sh run|test" >&2; 
 
 tools/install_deps.sh
 jobs=$(nproc)
-build() {  # build DIR [cmake options...]
+build() {  # build DIR [cmake options...]: every option is given each time, so nothing an earlier
+           # configuration of DIR left in its cache (say, the tests switched off by `run`) carries over
   local dir=$1; shift
-  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+  cmake -S . -B "$dir" -G Ninja "$@" >/dev/null
   cmake --build "$dir" -j "$jobs"
+}
+# Fails when a label has no tests: a configuration that silently left a group out must not pass.
+expect_tests() {  # expect_tests DIR LABEL...
+  local dir=$1; shift
+  for label in "$@"; do
+    local count
+    count=$(ctest --test-dir "$dir" -N -L "^$label\$" | sed -n 's/^Total Tests: //p')
+    if [ "${count:-0}" -eq 0 ]; then
+      echo "quickstart: no tests labelled '$label' in $dir" >&2
+      exit 1
+    fi
+    echo "quickstart: $count tests labelled '$label'"
+  done
 }
 
 if [ "$what" = run ]; then
-  build build -DLIDARLOOP_BUILD_TESTS=OFF
+  build build -DCMAKE_BUILD_TYPE=Release -DLIDARLOOP_BUILD_TESTS=OFF -DLIDARLOOP_SANITIZE=OFF
   # Main job: the default dynamic scenario with the localizer in the loop, scored against ground
   # truth (exit 1 if it fails its thresholds).
   exec build/tools/lidarloop run scenarios/dynamic_campus.yaml --out build/out/dynamic_campus
 fi
 
-build build
-ctest --test-dir build --output-on-failure -j "$jobs"
+build build -DCMAKE_BUILD_TYPE=Release -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=OFF
+expect_tests build unit cli scenario map node
+ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs"
 # The unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer.
-build build-sanitize -DLIDARLOOP_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
+build build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=ON
+expect_tests build-sanitize unit
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --test-dir build-sanitize --output-on-failure -j "$jobs" -L unit
+  ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j "$jobs" -L unit
