@@ -36,11 +36,172 @@ void check_grid_params(const IntensityGridParams& p, const char* who) {
     throw std::invalid_argument(std::string(who) + ": cell_m must be a positive number");
 }
 
-bool same_length(double a, double b) { return std::fabs(a - b) <= kLengthTolerance * std::max(std::fabs(a), std::fabs(b)); }
+bool same_length(double a, double b) {
+  return std::fabs(a - b) <= kLengthTolerance * std::max(std::fabs(a), std::fabs(b));
+}
 
 // Number of whole steps in [0, range] (a range that is a multiple of the step keeps its last step).
 int steps_in(double range_m, double step_m) {
   return static_cast<int>(std::floor(range_m / step_m + kLengthTolerance));
+}
+
+// S against the map it is matched on, and the parameters of Eq. 14 (the window's are checked by
+// aps_search_window).
+void check_aps_inputs(const IntensityGrid& S, double map_resolution_m, const ApsParams& params) {
+  check_grid_params(S.params, "aps_match");
+  if (!same_length(S.params.cell_m, map_resolution_m))
+    throw std::invalid_argument("aps_match: grid cell size " + std::to_string(S.params.cell_m) +
+                                " m is not the map's resolution " + std::to_string(map_resolution_m) + " m");
+  if (S.cells.size() != size_t(S.params.width_cells) * size_t(S.params.height_cells))
+    throw std::invalid_argument("aps_match: grid has " + std::to_string(S.cells.size()) + " cells, expected w_s * h_s");
+  if (!(params.alpha > 0 && std::isfinite(params.alpha)))
+    throw std::invalid_argument("aps_match: alpha must be a positive number");
+  if (!(params.min_sigma > 0 && std::isfinite(params.min_sigma)))
+    throw std::invalid_argument("aps_match: min_sigma must be a positive number");
+}
+
+// The effective area of S: cells with S_n > n_e (fewer points: the mean is too noisy).
+bool usable(const IntensityCell& s, const ApsParams& params) {
+  return s.count > uint32_t(std::max(params.min_count, 0));
+}
+
+// Eq. 14 as printed adds variances and squares the sum, which is dimensionally intensity^4 over
+// intensity^2; reading sigma as the standard deviation makes the exponent a squared z-score, as in APS.
+double floored_sigma(const IntensityCell& cell, double min_sigma) {
+  return std::max(std::sqrt(cell.variance()), min_sigma);
+}
+
+// The marked cells of a cols x rows grid, counted over any rectangle in O(1): a summed-area table.
+class CellCounts {
+ public:
+  // marked(c, r): whether cell (c, r) counts.
+  template <class Marked>
+  CellCounts(int cols, int rows, Marked marked)
+      : cols_(cols), rows_(rows), sums_(size_t(cols + 1) * size_t(rows + 1), 0) {
+    for (int r = 0; r < rows; ++r) {
+      int in_row = 0;
+      for (int c = 0; c < cols; ++c) {
+        in_row += marked(c, r) ? 1 : 0;
+        sums_[index(c + 1, r + 1)] = sums_[index(c + 1, r)] + in_row;
+      }
+    }
+  }
+  int cols() const { return cols_; }
+  int rows() const { return rows_; }
+  // Marked cells in columns [c0, c0 + cols) and rows [r0, r0 + rows), all inside the grid.
+  int in(int c0, int r0, int cols, int rows) const {
+    return sums_[index(c0 + cols, r0 + rows)] - sums_[index(c0, r0 + rows)] - sums_[index(c0 + cols, r0)] +
+           sums_[index(c0, r0)];
+  }
+
+ private:
+  size_t index(int c, int r) const { return size_t(r) * size_t(cols_ + 1) + size_t(c); }
+  int cols_, rows_;
+  std::vector<int> sums_;  // (cols + 1) x (rows + 1): the marked cells above and left of each corner
+};
+
+// Where S is usable. On a road most of S is empty (the corridor's ground only), so most of the map
+// window is never looked at and need not be read.
+CellCounts usable_cells(const IntensityGrid& S, const ApsParams& params) {
+  const int w = S.params.width_cells;
+  return CellCounts(w, S.params.height_cells,
+                    [&](int c, int r) { return usable(S.cells[size_t(r) * size_t(w) + size_t(c)], params); });
+}
+
+// S cell (c, r) looks at window cells [c, c + 2 margin_x] x [r, r + 2 margin_y], so window cell
+// (wc, wr) is needed if S has a usable cell in [wc - 2 margin_x, wc] x [wr - 2 margin_y, wr].
+bool needed(const CellCounts& usable, const ApsSearchWindow& window, int wc, int wr) {
+  const int c0 = std::max(wc - 2 * window.margin_x(), 0), c1 = std::min(wc, usable.cols() - 1);
+  const int r0 = std::max(wr - 2 * window.margin_y(), 0), r1 = std::min(wr, usable.rows() - 1);
+  if (c0 > c1 || r0 > r1) return false;
+  return usable.in(c0, r0, c1 - c0 + 1, r1 - r0 + 1) > 0;
+}
+
+// The map under S enlarged by the search margins, in S's vehicle-frame cells: window cell (c, r) is
+// S cell (c - margin_x, r - margin_y) at offset zero. Single precision for the search: intensities are
+// whole counts 0-255 and the sums a few thousand z-scores, far inside float's 7 digits, and the inner
+// loop does twice the offsets per instruction.
+struct MapWindow {
+  int cols = 0, rows = 0;
+  std::vector<float> mean;   // NaN where the map has no data
+  std::vector<float> sigma;  // floored standard deviation
+  // Window cells without map data, to ask in O(1) whether an S cell stays on the map at every offset.
+  // A cell nobody needs counts as present, which no question can tell apart.
+  CellCounts missing;
+
+  size_t index(int c, int r) const { return size_t(r) * size_t(cols) + size_t(c); }
+};
+
+// Reads the map only where usable S cells can look (one lookup per needed window cell).
+MapWindow map_under_window(const IntensityGrid& S, IntensityMap& map, const ApsSearchWindow& window,
+                           const CellCounts& usable, double min_sigma) {
+  const int cols = S.params.width_cells + 2 * window.margin_x(), rows = S.params.height_cells + 2 * window.margin_y();
+  const auto at = [cols](int c, int r) { return size_t(r) * size_t(cols) + size_t(c); };
+  const Eigen::Matrix2d R = rotation(S.pose.yaw);
+  const Eigen::Vector2d origin(S.pose.x, S.pose.y);
+  std::vector<float> mean(size_t(cols) * size_t(rows), 0.0f), sigma(size_t(cols) * size_t(rows), float(min_sigma));
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      if (!needed(usable, window, c, r)) continue;
+      const Eigen::Vector2d local = origin + R * S.cell_centre(c - window.margin_x(), r - window.margin_y());
+      const std::optional<IntensityCell> m = map.cell(local);
+      if (m && m->count > 0) {
+        mean[at(c, r)] = float(m->mean);
+        sigma[at(c, r)] = float(floored_sigma(*m, min_sigma));
+      } else {
+        mean[at(c, r)] = std::numeric_limits<float>::quiet_NaN();
+      }
+    }
+  }
+  CellCounts missing(cols, rows, [&](int c, int r) { return std::isnan(mean[at(c, r)]); });
+  return {cols, rows, std::move(mean), std::move(sigma), std::move(missing)};
+}
+
+// Eq. 14's exponent per offset, without its -alpha/2: the sum of squared z-scores
+// (m_r - s_r)^2 / (m_sigma + s_sigma)^2 over the cells of S that take part.
+struct ZScoreSums {
+  std::vector<float> per_offset;  // row-major, offsets_x() per row
+  int cells_used = 0;
+};
+
+// A cell of S takes part if it is usable and the map has data under it at every offset, so every
+// offset is scored on the same cells. The loop over offsets is innermost: each offset has its own
+// accumulator, so it vectorises.
+ZScoreSums z_score_sums(const IntensityGrid& S, const MapWindow& m, const ApsSearchWindow& window,
+                        const ApsParams& params) {
+  const int w = S.params.width_cells, h = S.params.height_cells;
+  const int ox = window.offsets_x(), oy = window.offsets_y(), step = window.step_cells;
+  const float* map_mean = m.mean.data();
+  const float* map_sigma = m.sigma.data();
+  ZScoreSums sums;
+  sums.per_offset.assign(size_t(ox) * size_t(oy), 0.0f);
+  for (int r = 0; r < h; ++r) {
+    for (int c = 0; c < w; ++c) {
+      const IntensityCell& s = S.cells[size_t(r) * size_t(w) + size_t(c)];
+      if (!usable(s, params)) continue;
+      // Window cell (c, r) is S cell (c, r) shifted by the most negative offset.
+      if (m.missing.in(c, r, 2 * window.margin_x() + 1, 2 * window.margin_y() + 1) != 0) continue;
+      ++sums.cells_used;
+      const float s_r = float(s.mean), s_sigma = float(floored_sigma(s, params.min_sigma));
+      for (int j = 0; j < oy; ++j) {
+        const size_t base = m.index(c, r + j * step);
+        float* acc = &sums.per_offset[size_t(j) * size_t(ox)];
+        for (int i = 0; i < ox; ++i) {
+          const size_t k = base + size_t(i * step);
+          const float d = map_mean[k] - s_r, e = map_sigma[k] + s_sigma;
+          acc[i] += d * d / (e * e);
+        }
+      }
+    }
+  }
+  return sums;
+}
+
+// No information beyond "somewhere in the window": a uniform spread over it (variance range^2 / 3),
+// vehicle frame.
+Eigen::Matrix2d uniform_over_window(const ApsSearchWindow& window) {
+  const Eigen::Vector2d range(window.nx * window.step_m, window.ny * window.step_m);
+  return (range.array().square() / 3.0).matrix().asDiagonal();
 }
 
 }  // namespace
@@ -54,7 +215,8 @@ const IntensityCell& IntensityGrid::at(int col, int row) const {
 
 Eigen::Vector2d IntensityGrid::cell_centre(int col, int row) const {
   // The vehicle sits at the grid's centre: half the columns ahead of it, half behind.
-  return {(col + 0.5 - 0.5 * params.width_cells) * params.cell_m, (row + 0.5 - 0.5 * params.height_cells) * params.cell_m};
+  return {(col + 0.5 - 0.5 * params.width_cells) * params.cell_m,
+          (row + 0.5 - 0.5 * params.height_cells) * params.cell_m};
 }
 
 IntensityGrid build_intensity_grid(const std::vector<Eigen::Vector3d>& ground_points_vehicle,
@@ -80,159 +242,85 @@ IntensityGrid build_intensity_grid(const std::vector<Eigen::Vector3d>& ground_po
   return grid;
 }
 
-ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& params) {
-  check_grid_params(S.params, "aps_match");
-  const double cell = S.params.cell_m;
-  if (!same_length(cell, map.header().resolution_m))
-    throw std::invalid_argument("aps_match: grid cell size " + std::to_string(cell) + " m is not the map's resolution " +
-                                std::to_string(map.header().resolution_m) + " m");
-  if (S.cells.size() != size_t(S.params.width_cells) * size_t(S.params.height_cells))
-    throw std::invalid_argument("aps_match: grid has " + std::to_string(S.cells.size()) + " cells, expected w_s * h_s");
+ApsSearchWindow aps_search_window(const ApsParams& params, double cell_m) {
+  if (!(std::isfinite(cell_m) && cell_m > 0))
+    throw std::invalid_argument("aps_search_window: cell_m must be a positive number");
   if (!(std::isfinite(params.step_m) && params.step_m > 0))
-    throw std::invalid_argument("aps_match: step_m must be a positive number");
-  const int step_cells = static_cast<int>(std::lround(params.step_m / cell));
-  if (step_cells < 1 || !same_length(step_cells * cell, params.step_m))
-    throw std::invalid_argument("aps_match: step_m must be a whole number of cells");
+    throw std::invalid_argument("aps_search_window: step_m must be a positive number");
+  const int step_cells = static_cast<int>(std::lround(params.step_m / cell_m));
+  if (step_cells < 1 || !same_length(step_cells * cell_m, params.step_m))
+    throw std::invalid_argument("aps_search_window: step_m must be a whole number of cells");
   if (!(params.lateral_range_m >= 0 && params.longitudinal_range_m >= 0 && std::isfinite(params.lateral_range_m) &&
         std::isfinite(params.longitudinal_range_m)))
-    throw std::invalid_argument("aps_match: search ranges must be finite and non-negative");
-  if (!(params.alpha > 0 && std::isfinite(params.alpha)))
-    throw std::invalid_argument("aps_match: alpha must be a positive number");
-  if (!(params.min_sigma > 0 && std::isfinite(params.min_sigma)))
-    throw std::invalid_argument("aps_match: min_sigma must be a positive number");
+    throw std::invalid_argument("aps_search_window: search ranges must be finite and non-negative");
+  ApsSearchWindow window;
+  window.nx = steps_in(params.longitudinal_range_m, params.step_m);
+  window.ny = steps_in(params.lateral_range_m, params.step_m);
+  window.step_cells = step_cells;
+  window.step_m = params.step_m;
+  return window;
+}
 
-  const int nx = steps_in(params.longitudinal_range_m, params.step_m);  // offsets -nx..nx along x
-  const int ny = steps_in(params.lateral_range_m, params.step_m);
-  const int margin_x = nx * step_cells, margin_y = ny * step_cells;  // window margin, in cells
-  const int w = S.params.width_cells, h = S.params.height_cells;
-  const int ww = w + 2 * margin_x, wh = h + 2 * margin_y;
-  const Eigen::Matrix2d R = rotation(S.pose.yaw);
-  const Eigen::Vector2d origin(S.pose.x, S.pose.y);
+std::vector<double> aps_log_probabilities(const std::vector<float>& z_score_sums, double alpha) {
+  std::vector<double> log_p(z_score_sums.size());
+  for (size_t k = 0; k < z_score_sums.size(); ++k) log_p[k] = -0.5 * alpha * double(z_score_sums[k]);
+  return log_p;
+}
 
-  // Usable cells of S (S_n > n_e), and a summed-area table of them: a window cell matters only if some
-  // usable S cell looks at it at some offset, and on a road most of S is empty (the corridor's ground
-  // only), so most of the window need not be read from the map at all.
-  const uint32_t min_count = uint32_t(std::max(params.min_count, 0));
-  auto usable = [&](int c, int r) { return S.cells[size_t(r) * size_t(w) + size_t(c)].count > min_count; };
-  std::vector<int> usable_sat(size_t(w + 1) * size_t(h + 1), 0);
-  for (int r = 0; r < h; ++r) {
-    int row_usable = 0;
-    for (int c = 0; c < w; ++c) {
-      row_usable += usable(c, r) ? 1 : 0;
-      usable_sat[size_t(r + 1) * size_t(w + 1) + size_t(c + 1)] =
-          usable_sat[size_t(r) * size_t(w + 1) + size_t(c + 1)] + row_usable;
-    }
-  }
-  // S cell (c, r) looks at window cells [c, c + 2 margin_x] x [r, r + 2 margin_y], so window cell
-  // (wc, wr) is needed if S has a usable cell in [wc - 2 margin_x, wc] x [wr - 2 margin_y, wr].
-  auto needed = [&](int wc, int wr) {
-    const int c0 = std::max(wc - 2 * margin_x, 0), c1 = std::min(wc, w - 1);
-    const int r0 = std::max(wr - 2 * margin_y, 0), r1 = std::min(wr, h - 1);
-    if (c0 > c1 || r0 > r1) return false;
-    auto at = [&](int c, int r) { return usable_sat[size_t(r) * size_t(w + 1) + size_t(c)]; };
-    return at(c1 + 1, r1 + 1) - at(c0, r1 + 1) - at(c1 + 1, r0) + at(c0, r0) > 0;
-  };
+bool aps_peak_on_edge(const std::vector<double>& log_p, const ApsSearchWindow& window) {
+  const int ox = window.offsets_x(), oy = window.offsets_y();
+  const auto best = std::max_element(log_p.begin(), log_p.end()) - log_p.begin();
+  const int i = int(best % ox), j = int(best / ox);
+  return (window.nx > 0 && (i == 0 || i == ox - 1)) || (window.ny > 0 && (j == 0 || j == oy - 1));
+}
 
-  // The map under the vehicle-frame window: mean, floored standard deviation, and a summed-area table
-  // of the cells without data (to ask in O(1) whether an S cell stays on the map at every offset; a cell
-  // nobody needs counts as present, which no question can tell apart).
-  // Single precision for the search: intensities are whole counts 0-255 and the sums a few thousand
-  // z-scores, far inside float's 7 digits, and the inner loop does twice the offsets per instruction.
-  std::vector<float> map_mean(size_t(ww) * size_t(wh), 0.0f), map_sigma(size_t(ww) * size_t(wh), float(params.min_sigma));
-  std::vector<int> missing_sat(size_t(ww + 1) * size_t(wh + 1), 0);
-  for (int r = 0; r < wh; ++r) {
-    int row_missing = 0;
-    for (int c = 0; c < ww; ++c) {
-      if (needed(c, r)) {
-        const Eigen::Vector2d local = origin + R * S.cell_centre(c - margin_x, r - margin_y);
-        const std::optional<IntensityCell> m = map.cell(local);
-        const size_t k = size_t(r) * size_t(ww) + size_t(c);
-        if (m && m->count > 0) {
-          map_mean[k] = float(m->mean);
-          // Eq. 14 as printed adds variances and squares the sum, which is dimensionally intensity^4
-          // over intensity^2; reading sigma as the standard deviation makes the exponent a squared
-          // z-score, as in APS.
-          map_sigma[k] = float(std::max(std::sqrt(m->variance()), params.min_sigma));
-        } else {
-          ++row_missing;
-        }
-      }
-      missing_sat[size_t(r + 1) * size_t(ww + 1) + size_t(c + 1)] =
-          missing_sat[size_t(r) * size_t(ww + 1) + size_t(c + 1)] + row_missing;
-    }
-  }
-  // Missing map cells in window rows [r0, r0 + rows), columns [c0, c0 + cols).
-  auto missing_in = [&](int c0, int r0, int cols, int rows) {
-    auto at = [&](int c, int r) { return missing_sat[size_t(r) * size_t(ww + 1) + size_t(c)]; };
-    return at(c0 + cols, r0 + rows) - at(c0, r0 + rows) - at(c0 + cols, r0) + at(c0, r0);
-  };
-
-  // Eq. 14 in logs: log P(o) = alpha * sum -(m_r - s_r)^2 / (2 (m_sigma + s_sigma)^2). The loop over
-  // offsets is innermost: each offset has its own accumulator, so it vectorises.
-  const int ox = 2 * nx + 1, oy = 2 * ny + 1;
-  std::vector<float> sum_sq(size_t(ox) * size_t(oy), 0.0f);  // sum of squared z-scores per offset
-  int used = 0;
-  for (int r = 0; r < h; ++r) {
-    for (int c = 0; c < w; ++c) {
-      if (!usable(c, r)) continue;  // effective area: S_n > n_e
-      const IntensityCell& s = S.cells[size_t(r) * size_t(w) + size_t(c)];
-      // Window cell (c, r) is S cell (c, r) shifted by the most negative offset.
-      if (missing_in(c, r, 2 * margin_x + 1, 2 * margin_y + 1) != 0) continue;
-      ++used;
-      const float s_r = float(s.mean), s_sigma = float(std::max(std::sqrt(s.variance()), params.min_sigma));
-      for (int j = 0; j < oy; ++j) {
-        const size_t base = size_t(r + j * step_cells) * size_t(ww) + size_t(c);
-        float* acc = &sum_sq[size_t(j) * size_t(ox)];
-        for (int i = 0; i < ox; ++i) {
-          const size_t k = base + size_t(i * step_cells);
-          const float d = map_mean[k] - s_r, e = map_sigma[k] + s_sigma;
-          acc[i] += d * d / (e * e);
-        }
-      }
-    }
-  }
-
-  ApsResult result;
-  result.cells_used = used;
-  result.position = origin;
-  const Eigen::Vector2d range(nx * params.step_m, ny * params.step_m);
-  if (used < params.min_cells) {
-    // No information beyond "somewhere in the window": a uniform spread over it (variance range^2/3).
-    const Eigen::Matrix2d c = (range.array().square() / 3.0).matrix().asDiagonal();
-    result.covariance = R * c * R.transpose();
-    return result;
-  }
-
-  // Normalise by the best offset before exponentiating: the raw sums are thousands, exp() would be 0.
-  std::vector<double> log_p(sum_sq.size());
-  for (size_t k = 0; k < sum_sq.size(); ++k) log_p[k] = -0.5 * params.alpha * double(sum_sq[k]);
-  const auto best_at = std::max_element(log_p.begin(), log_p.end());
-  const double best = *best_at;
-  const int best_i = int((best_at - log_p.begin()) % ox), best_j = int((best_at - log_p.begin()) / ox);
-  result.peak_on_edge = (nx > 0 && (best_i == 0 || best_i == ox - 1)) || (ny > 0 && (best_j == 0 || best_j == oy - 1));
+OffsetMoments aps_offset_moments(const std::vector<double>& log_p, const ApsSearchWindow& window) {
+  // Relative to the best offset before exponentiating: the raw sums are thousands, exp() would be 0.
+  const double best = *std::max_element(log_p.begin(), log_p.end());
+  const int ox = window.offsets_x(), oy = window.offsets_y();
   double total = 0;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
   for (int j = 0; j < oy; ++j) {
     for (int i = 0; i < ox; ++i) {
       const double p = std::exp(log_p[size_t(j) * size_t(ox) + size_t(i)] - best);
-      const Eigen::Vector2d o((i - nx) * params.step_m, (j - ny) * params.step_m);
+      const Eigen::Vector2d o = window.offset(i, j);
       total += p;
       mean += p * o;
       second += p * o * o.transpose();
     }
   }
   mean /= total;  // Eq. 15-16: centre of mass
-  Eigen::Matrix2d cov = second / total - mean * mean.transpose();
+  Eigen::Matrix2d covariance = second / total - mean * mean.transpose();
   // A distribution on a grid of steps can put all its mass on one offset; the estimate is still only
   // known to within a step, so add the variance of a uniform spread over one step (step^2 / 12).
-  const double quantisation = params.step_m * params.step_m / 12.0;
-  cov.diagonal().array() += quantisation;
+  covariance.diagonal().array() += window.step_m * window.step_m / 12.0;
+  return {mean, covariance};
+}
 
+ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& params) {
+  check_aps_inputs(S, map.header().resolution_m, params);
+  const ApsSearchWindow window = aps_search_window(params, S.params.cell_m);
+  const CellCounts usable = usable_cells(S, params);
+  const MapWindow under_s = map_under_window(S, map, window, usable, params.min_sigma);
+  const ZScoreSums sums = z_score_sums(S, under_s, window, params);
+
+  const Eigen::Matrix2d R = rotation(S.pose.yaw);
+  const Eigen::Vector2d origin(S.pose.x, S.pose.y);
+  ApsResult result;
+  result.cells_used = sums.cells_used;
+  result.position = origin;
+  if (sums.cells_used < params.min_cells) {
+    result.covariance = R * uniform_over_window(window) * R.transpose();
+    return result;
+  }
+  const std::vector<double> log_p = aps_log_probabilities(sums.per_offset, params.alpha);  // Eq. 14
+  const OffsetMoments moments = aps_offset_moments(log_p, window);                         // Eq. 15-16
   result.ok = true;
-  result.offset_vehicle = mean;
-  result.position = origin + R * mean;  // Eq. 17-18, the offset rotated from the vehicle frame
-  result.covariance = R * cov * R.transpose();
+  result.peak_on_edge = aps_peak_on_edge(log_p, window);
+  result.offset_vehicle = moments.mean;
+  result.position = origin + R * moments.mean;  // Eq. 17-18, the offset rotated from the vehicle frame
+  result.covariance = R * moments.covariance * R.transpose();
   return result;
 }
 

@@ -84,4 +84,46 @@ struct ApsResult {
 // std::invalid_argument if S's cell size is not the map's resolution or a parameter is out of range.
 ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& params = {});
 
+// The steps of aps_match that stand on their own. In its order: check the inputs; the search window;
+// where S is usable (S_n > n_e); the map resampled under S and the window; per offset, the sum of
+// squared z-scores of Eq. 14; Eq. 14 in logs; the peak's place and the moments (Eq. 15-16); the
+// position (Eq. 17-18).
+
+// The offsets APS scores: -nx..nx steps along x (longitudinal), -ny..ny along y (lateral), each step
+// `step_cells` cells of S, which are the map's cells.
+struct ApsSearchWindow {
+  int nx = 0, ny = 0;
+  int step_cells = 1;
+  double step_m = 0;
+
+  int offsets_x() const { return 2 * nx + 1; }
+  int offsets_y() const { return 2 * ny + 1; }
+  // How far the offsets reach beyond S on each side, in cells.
+  int margin_x() const { return nx * step_cells; }
+  int margin_y() const { return ny * step_cells; }
+  // Offset (i, j), i in [0, offsets_x()) and j in [0, offsets_y()), in the vehicle frame (m).
+  Eigen::Vector2d offset(int i, int j) const { return {(i - nx) * step_m, (j - ny) * step_m}; }
+};
+
+// The window of params' ranges (whole steps: a range that is a multiple of the step keeps its last
+// one) for cells of cell_m. Throws std::invalid_argument unless step_m is a positive whole number of
+// cells and the ranges are finite and non-negative.
+ApsSearchWindow aps_search_window(const ApsParams& params, double cell_m);
+
+// Eq. 14 in logs, offset by offset: log P = -alpha / 2 * (the offset's sum of squared z-scores
+// (m_r - s_r)^2 / (m_sigma + s_sigma)^2). Up to a constant, which the moments do not need.
+std::vector<double> aps_log_probabilities(const std::vector<float>& z_score_sums, double alpha);
+
+// Whether the most probable offset lies on the window's border (along an axis with more than one
+// offset). log_p: row-major, offsets_x() per row.
+bool aps_peak_on_edge(const std::vector<double>& log_p, const ApsSearchWindow& window);
+
+// Eq. 15-16: the centre of mass of P over the offsets, and P's covariance plus the variance of a
+// uniform spread over one step (the estimate is only known to a step), vehicle frame.
+struct OffsetMoments {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+};
+OffsetMoments aps_offset_moments(const std::vector<double>& log_p, const ApsSearchWindow& window);
+
 }  // namespace lidarloop

@@ -2,9 +2,10 @@
 // How well a curb match pins the pose down, for the Kalman filter's curb observation (paper 3.3).
 // Point-to-point ICP (Eq. 9) finds the transform but says nothing about its uncertainty, and the
 // uncertainty is very anisotropic: curbs along a straight road fix the lateral position and the heading
-// but leave the longitudinal free (DESIGN.md; the reason the intensity layer exists). Each matched curb
-// constrains the pose only across its map curb line, so the information of the match is the sum of
-// point-to-line Jacobians, and its inverse is the observation covariance.
+// but leave the longitudinal free, which is why the map also has an intensity layer (road paint fixes
+// the position along the road). Each matched curb constrains the pose only across its map curb line, so
+// the information of the match is the sum of point-to-line Jacobians, and its inverse is the
+// observation covariance.
 #include <vector>
 
 #include <Eigen/Core>

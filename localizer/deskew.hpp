@@ -1,8 +1,8 @@
 #pragma once
-// Scan de-skew (beyond the paper; issue 5 asks for it): a Velodyne reports each point in the sensor
-// frame of its own firing instant, so a scan taken while driving is skewed (1 m over a 10 Hz scan at
-// 10 m/s). With the vehicle's speed and yaw rate from CAN over the scan, every point is brought into
-// the vehicle frame at one reference time, so the matchers see the world as it is.
+// Scan de-skew (beyond the paper, which treats a scan as one snapshot): a Velodyne reports each point
+// in the sensor frame of its own firing instant, so a scan taken while driving is skewed (1 m over a
+// 10 Hz scan at 10 m/s). With the vehicle's speed and yaw rate from CAN over the scan, every point is
+// brought into the vehicle frame at one reference time, so the matchers see the world as it is.
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -30,7 +30,8 @@ struct ScanPoints {
 // Points of `cloud` in the vehicle frame (origin at the rear axle) at time `reference_ns` after the
 // scan's stamp, assuming constant speed and yaw rate over the scan (a circular arc). `mount` is the
 // LiDAR's pose in the vehicle frame. Non-finite points are dropped.
-ScanPoints deskew(const PointCloud& cloud, const Eigen::Isometry3d& mount, const ScanMotion& motion, int64_t reference_ns);
+ScanPoints deskew(const PointCloud& cloud, const Eigen::Isometry3d& mount, const ScanMotion& motion,
+                  int64_t reference_ns);
 
 // Without motion compensation: every point through the mount only (what a naive consumer does).
 ScanPoints to_vehicle_frame(const PointCloud& cloud, const Eigen::Isometry3d& mount);

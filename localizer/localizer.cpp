@@ -1,7 +1,6 @@
 #include "localizer/localizer.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include <Eigen/Dense>
@@ -13,27 +12,117 @@
 #include "localizer/deskew.hpp"
 #include "localizer/driving_corridor.hpp"
 #include "localizer/obstacle_rejection.hpp"
+#include "localizer/stage_timer.hpp"
 
 namespace lidarloop {
 namespace {
 
 // Before the first fix there is no pose: the estimate says so with this (m^2, rad^2) on the diagonal.
 constexpr double kUnknownVariance = 1e6;
-
-class Stopwatch {
- public:
-  double lap_ms() {
-    const auto now = std::chrono::steady_clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-    return ms;
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
+// APS's window is rounded down to whole steps; a window meant to be a whole number of steps must not
+// lose its last one to rounding.
+constexpr double kWholeStepTolerance = 1e-9;
 
 Eigen::Vector2d xy(const Pose2d& p) { return {p.x, p.y}; }
+
+double& stage_ms(LocalizerEstimate& e, Stage s) { return e.stage_ms[size_t(s)]; }
+
+// The scan's last firing, after its stamp: the time the scan's pose is reported for.
+int64_t scan_duration_ns(const PointCloud& cloud) {
+  uint32_t last_t = 0;
+  for (const LidarPoint& p : cloud.points) last_t = std::max(last_t, p.t_ns);
+  return int64_t(last_t);
+}
+
+// The scan in the vehicle frame at `reference_ns` after its stamp, de-skewed with CAN's motion over
+// the scan unless that is switched off.
+ScanPoints vehicle_frame_points(const PointCloud& cloud, const LocalizerParams& params, const ScanMotion& motion,
+                                int64_t reference_ns, LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::deskew));
+  ScanPoints points = params.deskew ? deskew(cloud, params.lidar_mount, motion, reference_ns)
+                                    : to_vehicle_frame(cloud, params.lidar_mount);
+  e.points = points.size();
+  e.dropped_points = points.dropped;
+  if (points.dropped > 0) e.health |= kInvalidPoints;
+  return points;
+}
+
+// 2.1.1: the points inside the driving corridor around `prior` (indices into `points`); all of them
+// when there is no corridor (off the map).
+std::vector<size_t> corridor_points(const ScanPoints& points, const CurbLayer& curbs, const Pose2d& prior,
+                                    const CorridorParams& params, LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::corridor));
+  const double half = 0.5 * std::max(params.width_cells, params.height_cells) * params.cell_m;  // the grid's reach
+  const DrivingCorridor corridor = extract_driving_corridor(curbs.window(xy(prior), half), prior, params);
+  const bool have_corridor = !corridor.mask.empty();
+  if (!have_corridor) e.health |= kNoCorridor;
+  std::vector<size_t> inside;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (!have_corridor || corridor.contains(points.xyz[i].head<2>())) inside.push_back(i);
+  e.corridor_points = inside.size();
+  return inside;
+}
+
+// 2.1.2: the ground plane through the corridor's points (Eq. 2) and the obstacles above it (Eq. 3),
+// appended to `obstacles` (vehicle frame). Returns the road surface for S (indices into `points`):
+// the ground points close to the plane (see IntensityGridParams::max_height).
+std::vector<size_t> split_ground_and_obstacles(const ScanPoints& points, const std::vector<size_t>& corridor,
+                                               const LocalizerParams& params, std::vector<Eigen::Vector2d>& obstacles,
+                                               LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::obstacles));
+  std::vector<Eigen::Vector3d> corridor_xyz;
+  corridor_xyz.reserve(corridor.size());
+  for (size_t i : corridor) corridor_xyz.push_back(points.xyz[i]);
+  const ObstacleSplit split = reject_obstacles(corridor_xyz, params.obstacles);
+  if (!split.plane_ok) e.health |= kNoGroundPlane;
+  std::vector<size_t> ground;
+  for (size_t k : split.ground_index)
+    if (!split.plane_ok || distance_to_plane(split.plane, corridor_xyz[k]) <= params.intensity_grid.max_height)
+      ground.push_back(corridor[k]);
+  for (const auto& o : split.obstacles) obstacles.push_back(o.head<2>());
+  e.obstacle_points = obstacles.size();
+  return ground;
+}
+
+// 2.2.1, single frame: the curbs along the scan's rings (vehicle frame).
+std::vector<Eigen::Vector2d> detect_scan_curbs(const ScanPoints& points, const CurbDetectorParams& params,
+                                               LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::curb_detection));
+  std::vector<Eigen::Vector2d> curbs = detect_curbs(points.xyz, points.ring, params);
+  e.curbs_detected = curbs.size();
+  return curbs;
+}
+
+// 2.2.2: grid S of the road surface's intensities around the vehicle (Eq. 8), placed at `pose`.
+IntensityGrid intensity_grid(const ScanPoints& points, const std::vector<size_t>& ground, const Pose2d& pose,
+                             const IntensityGridParams& params, LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::intensity_matching));
+  std::vector<Eigen::Vector3d> ground_xyz;
+  std::vector<double> intensities;
+  ground_xyz.reserve(ground.size());
+  intensities.reserve(ground.size());
+  for (size_t i : ground) {
+    ground_xyz.push_back(points.xyz[i]);
+    intensities.push_back(points.intensity[i]);
+  }
+  return build_intensity_grid(ground_xyz, intensities, pose, params);
+}
+
+// The map's curbs around `centre` in a small KD-tree of their own: the matchers' thousands of
+// nearest-neighbour queries are then cheaper than in the whole map's tree.
+struct LocalCurbs {
+  MapIndex index;
+  std::vector<Eigen::Vector2d> tangents;  // of index.points(), in their order
+};
+
+LocalCurbs local_curbs(const CurbLayer& curbs, const Eigen::Vector2d& centre, double half_extent) {
+  std::vector<Eigen::Vector2d> points, tangents;
+  for (size_t i : curbs.window_indices(centre, half_extent)) {
+    points.push_back(curbs.points()[i]);
+    tangents.push_back(curbs.tangents()[i]);
+  }
+  return {MapIndex(std::move(points)), std::move(tangents)};
+}
 
 }  // namespace
 
@@ -43,10 +132,17 @@ CanMotion can_motion(const CanFrame& f, const VehicleModelParams& vehicle) {
 }
 
 std::string describe_health(uint32_t flags) {
-  static const std::array<const char*, kHealthFlagCount> names = {
-      "not initialised", "CAN gap",        "no GPS",           "invalid points",     "empty scan",
-      "no corridor",     "no ground plane", "few curbs",        "curb match rejected", "no intensity match",
-      "intensity match rejected"};
+  static const std::array<const char*, kHealthFlagCount> names = {"not initialised",
+                                                                  "CAN gap",
+                                                                  "no GPS",
+                                                                  "invalid points",
+                                                                  "empty scan",
+                                                                  "no corridor",
+                                                                  "no ground plane",
+                                                                  "few curbs",
+                                                                  "curb match rejected",
+                                                                  "no intensity match",
+                                                                  "intensity match rejected"};
   if (flags == 0) return "ok";
   std::string out;
   for (int i = 0; i < kHealthFlagCount; ++i)
@@ -56,8 +152,8 @@ std::string describe_health(uint32_t flags) {
 
 const char* stage_name(Stage s) {
   static const std::array<const char*, kStageCount> names = {
-      "deskew", "corridor", "obstacles", "curb_detection", "curb_features", "curb_matching", "intensity_matching",
-      "fusion"};
+      "deskew",        "corridor",      "obstacles",          "curb_detection",
+      "curb_features", "curb_matching", "intensity_matching", "fusion"};
   return names[size_t(s)];
 }
 
@@ -89,8 +185,7 @@ void Localizer::predict_to(int64_t t_ns) {
   // The filter moves by the odometry's increment in its own frame.
   const Pose2d step = relative(before, odometry_);
   filter_->predict(filter_->pose().compose(step), std::hypot(step.x, step.y), dt);
-  const bool can_stale =
-      !last_can_ns_ || double(t_ns - *last_can_ns_) / kNsPerS > params_.health.can_timeout_s;
+  const bool can_stale = !last_can_ns_ || double(t_ns - *last_can_ns_) / kNsPerS > params_.health.can_timeout_s;
   if (can_stale) {
     const double q = params_.process_position_without_can_per_s;
     filter_->inflate(Eigen::Vector3d(q * q * dt, q * q * dt, 0).asDiagonal());
@@ -155,117 +250,113 @@ bool Localizer::gate(double mahalanobis_sq, double threshold, int& rejections) {
 }
 
 LocalizerEstimate Localizer::on_scan(const PointCloud& cloud) {
-  Stopwatch total, watch;
   LocalizerEstimate e;
-  uint32_t last_t = 0;
-  for (const LidarPoint& p : cloud.points) last_t = std::max(last_t, p.t_ns);
-  e.stamp_ns = std::max(cloud.stamp_ns + int64_t(last_t), time_ns_);
-  predict_to(e.stamp_ns);
-  e.health = input_health(e.stamp_ns);
-  const Pose2d since_previous =
-      previous_scan_odometry_ ? relative(*previous_scan_odometry_, odometry_) : Pose2d{};
-  previous_scan_odometry_ = odometry_;
-  features_ = {};
-
-  auto finish = [&]() {
-    if (filter_) {
-      e.pose = filter_->pose();
-      e.covariance = filter_->covariance();
-    } else {
-      e.health |= kNotInitialized;
-      e.covariance = Eigen::Matrix3d::Identity() * kUnknownVariance;
-    }
-    e.total_ms = total.lap_ms();
-    return e;
-  };
-  const LocalizerMethod method = params_.method;
-  if (method == LocalizerMethod::gps) return finish();
-
-  const ScanPoints points =
-      params_.deskew ? deskew(cloud, params_.lidar_mount, {speed_, predictor_.yaw_rate()}, int64_t(last_t))
-                     : to_vehicle_frame(cloud, params_.lidar_mount);
-  e.points = points.size();
-  e.dropped_points = points.dropped;
-  if (points.dropped > 0) e.health |= kInvalidPoints;
-  e.stage_ms[size_t(Stage::deskew)] = watch.lap_ms();
-  if (e.points < size_t(std::max(params_.health.min_scan_points, 1)) || !filter_) {
-    if (e.points < size_t(std::max(params_.health.min_scan_points, 1))) e.health |= kEmptyScan;
-    accumulator_.add({}, since_previous);  // keep the older frames where they are relative to the car
-    return finish();
+  {
+    const StageTimer timer(e.total_ms);
+    process_scan(cloud, e);
+    report_pose(e);
   }
-  const Pose2d prior = filter_->pose();
-
-  // 2.1: the driving corridor, and the ground and obstacles inside it.
-  std::vector<size_t> ground;  // indices into points: the road surface
-  std::vector<Eigen::Vector2d> obstacles;
-  if (removes_obstacles(method)) {
-    const CorridorParams& cp = params_.corridor;
-    const double half = 0.5 * std::max(cp.width_cells, cp.height_cells) * cp.cell_m;
-    const DrivingCorridor corridor = extract_driving_corridor(map_.curbs.window(xy(prior), half), prior, cp);
-    std::vector<size_t> inside;
-    std::vector<Eigen::Vector3d> inside_xyz;
-    const bool have_corridor = !corridor.mask.empty();
-    if (!have_corridor) e.health |= kNoCorridor;
-    for (size_t i = 0; i < points.size(); ++i)
-      if (!have_corridor || corridor.contains(points.xyz[i].head<2>())) {
-        inside.push_back(i);
-        inside_xyz.push_back(points.xyz[i]);
-      }
-    e.corridor_points = inside.size();
-    e.stage_ms[size_t(Stage::corridor)] = watch.lap_ms();
-    const ObstacleSplit split = reject_obstacles(inside_xyz, params_.obstacles);
-    if (!split.plane_ok) e.health |= kNoGroundPlane;
-    for (size_t k : split.ground_index)  // the road surface, for S (see IntensityGridParams::max_height)
-      if (!split.plane_ok || distance_to_plane(split.plane, inside_xyz[k]) <= params_.intensity_grid.max_height)
-        ground.push_back(inside[k]);
-    for (const auto& o : split.obstacles) obstacles.push_back(o.head<2>());
-    e.obstacle_points = obstacles.size();
-    e.stage_ms[size_t(Stage::obstacles)] = watch.lap_ms();
-  }
-  features_.obstacles = obstacles;
-
-  // 2.2.1 and 3.1: curbs.
-  if (uses_curbs(method)) {
-    std::vector<Eigen::Vector2d> curbs = detect_curbs(points.xyz, points.ring, params_.curb_detector);
-    e.curbs_detected = curbs.size();
-    e.stage_ms[size_t(Stage::curb_detection)] = watch.lap_ms();
-    if (removes_obstacles(method))
-      curbs = reject_near_obstacles(curbs, obstacles, params_.curb_features.obstacle_distance);
-    accumulator_.add(curbs, since_previous);  // Eq. 4-5
-    std::vector<Eigen::Vector2d> features =
-        beam_model(accumulator_.curbs(), accumulator_.launch_points(), params_.curb_features);  // Eq. 6-7
-    e.curb_features = features.size();
-    e.stage_ms[size_t(Stage::curb_features)] = watch.lap_ms();
-    match_curbs(features, e);
-    features_.curbs = std::move(features);
-  }
-
-  // 2.2.2 and 3.2: intensity.
-  if (uses_intensity(method)) {
-    std::vector<Eigen::Vector3d> ground_xyz;
-    std::vector<double> intensities;
-    ground_xyz.reserve(ground.size());
-    intensities.reserve(ground.size());
-    for (size_t i : ground) {
-      ground_xyz.push_back(points.xyz[i]);
-      intensities.push_back(points.intensity[i]);
-    }
-    match_intensity(ground_xyz, intensities, e);
-  }
-  return finish();
+  return e;
 }
 
-void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, LocalizerEstimate& e) {
-  Stopwatch watch;
+// The paper's stages in its order; the method (LocalizerMethod) decides which run. Curbs and paint are
+// both extracted before either is matched, and APS searches around the pose the curb update left.
+void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
+  const int64_t scan_ns = scan_duration_ns(cloud);
+  e.stamp_ns = std::max(cloud.stamp_ns + scan_ns, time_ns_);
+  predict_to(e.stamp_ns);  // Eq. 19 from CAN
+  e.health = input_health(e.stamp_ns);
+  const Pose2d motion = motion_since_previous_scan();
+  features_ = {};
+  const LocalizerMethod method = params_.method;
+  if (method == LocalizerMethod::gps) return;
+
+  const ScanPoints points = vehicle_frame_points(cloud, params_, {speed_, predictor_.yaw_rate()}, scan_ns, e);
+  const bool empty = points.size() < size_t(std::max(params_.health.min_scan_points, 1));
+  if (empty) e.health |= kEmptyScan;
+  if (empty || !filter_) {
+    accumulator_.add({}, motion);  // keep the older frames where they are relative to the car
+    return;
+  }
+
+  std::vector<size_t> ground;  // the road surface, indices into points
+  if (removes_obstacles(method)) {
+    const std::vector<size_t> corridor =
+        corridor_points(points, map_.curbs, filter_->pose(), params_.corridor, e);           // 2.1.1
+    ground = split_ground_and_obstacles(points, corridor, params_, features_.obstacles, e);  // 2.1.2
+  }
+  if (uses_curbs(method))  // 2.2.1
+    features_.curbs =
+        curb_features(detect_scan_curbs(points, params_.curb_detector, e), features_.obstacles, motion, e);
+  std::optional<IntensityGrid> S;
+  if (uses_intensity(method)) S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, e);  // 2.2.2
+
+  if (uses_curbs(method)) {
+    const std::optional<CurbObservation> z = match_curbs(features_.curbs, e);  // 3.1
+    if (z) fuse_curbs(*z, e);                                                  // 3.3
+  }
+  if (S) {
+    const std::optional<ApsResult> z = match_intensity(*S, e);  // 3.2
+    if (z) fuse_intensity(*z, e);                               // 3.3
+  }
+}
+
+Pose2d Localizer::motion_since_previous_scan() {
+  const Pose2d motion = previous_scan_odometry_ ? relative(*previous_scan_odometry_, odometry_) : Pose2d{};
+  previous_scan_odometry_ = odometry_;
+  return motion;
+}
+
+// 2.2.1: this scan's curbs, less those at the feet of obstacles (d_o), accumulated over the last
+// frames with odometry (Eq. 4-5) and thinned to the contour the beams see (Eq. 6-7).
+std::vector<Eigen::Vector2d> Localizer::curb_features(std::vector<Eigen::Vector2d> curbs,
+                                                      const std::vector<Eigen::Vector2d>& obstacles,
+                                                      const Pose2d& motion, LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::curb_features));
+  if (removes_obstacles(params_.method))
+    curbs = reject_near_obstacles(curbs, obstacles, params_.curb_features.obstacle_distance);
+  accumulator_.add(curbs, motion);  // Eq. 4-5
+  std::vector<Eigen::Vector2d> features =
+      beam_model(accumulator_.curbs(), accumulator_.launch_points(), params_.curb_features);  // Eq. 6-7
+  e.curb_features = features.size();
+  return features;
+}
+
+// 3.1: the pose the curb features put the car at, matched against the map's curbs around the prior,
+// with the covariance the match supports; nullopt (and why, in e.health) if there is none to use.
+std::optional<Localizer::CurbObservation> Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features,
+                                                                 LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::curb_matching));
   if (features.size() < size_t(params_.health.min_curbs)) {
     e.health |= kFewCurbs;
-    return;
+    return std::nullopt;
   }
   const Pose2d prior = filter_->pose();
   std::vector<Eigen::Vector2d> world;
   world.reserve(features.size());
   for (const auto& f : features) world.push_back(vehicle_to_world(prior, f));
+  const LocalCurbs local = local_curbs(map_.curbs, xy(prior), params_.map_window_m);
+  const std::optional<Pose2d> t = curb_correction(world, local.index, prior);
+  if (!t) {
+    e.health |= kCurbMatchRejected;
+    return std::nullopt;
+  }
+  const Eigen::Vector2d corrected_xy = t->apply(xy(prior));
+  const Pose2d z{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t->yaw)};
+  const CurbMatchQuality q = curb_match_quality(features, z, local.index, local.tangents, params_.curb_noise);
+  e.curb_observation = z;
+  e.curb_inlier_ratio = q.inlier_ratio;
+  if (q.inlier_ratio < params_.health.min_inlier_ratio) {
+    e.health |= kCurbMatchRejected;
+    return std::nullopt;
+  }
+  return CurbObservation{z, q.covariance};
+}
 
+// The correction of the prior that the method's matcher finds (a transform of the local frame):
+// probabilistic ICP (3.1) or a baseline. nullopt if FMT finds none.
+std::optional<Pose2d> Localizer::curb_correction(const std::vector<Eigen::Vector2d>& features_world,
+                                                 const MapIndex& local_map, const Pose2d& prior) {
   // Correspondences as far as the prior is uncertain (see icp_window_sigmas).
   const double sigma = std::sqrt(filter_->covariance().topLeftCorner<2, 2>().eigenvalues().real().maxCoeff());
   auto widened = [&](IcpParams p) {
@@ -273,101 +364,94 @@ void Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features, Locali
         std::max(p.max_correspondence, std::min(params_.icp_window_sigmas * sigma, params_.icp_max_correspondence_m));
     return p;
   };
-  // The map's curbs around the prior in a small KD-tree of their own: the matchers' thousands of
-  // nearest-neighbour queries are then cheaper than in the whole map's tree.
-  std::vector<Eigen::Vector2d> local_points, local_tangents;
-  for (size_t i : map_.curbs.window_indices(xy(prior), params_.map_window_m)) {
-    local_points.push_back(map_.curbs.points()[i]);
-    local_tangents.push_back(map_.curbs.tangents()[i]);
-  }
-  const MapIndex local_map(local_points);
-  Pose2d t;
   switch (params_.method) {
     case LocalizerMethod::proposed: {
       ProbabilisticIcpParams p = params_.probabilistic_icp;
       p.local = widened(p.local);  // the global ICP keeps d_g
-      t = probabilistic_icp(local_map, world, {}, p, rng_).t;
-      break;
+      return probabilistic_icp(local_map, features_world, {}, p, rng_).t;
     }
     case LocalizerMethod::icp:
     case LocalizerMethod::icp_obs:
-      t = icp(local_map, world, {}, widened(params_.icp)).t;
-      break;
+      return icp(local_map, features_world, {}, widened(params_.icp)).t;
     case LocalizerMethod::m_icp: {
       MIcpParams p = params_.m_icp;
       p.icp = widened(p.icp);
-      t = m_icp(local_map, world, {}, p).t;
-      break;
+      return m_icp(local_map, features_world, {}, p).t;
     }
     case LocalizerMethod::fmt: {
-      const FmtResult f = fmt_match(world, local_points, xy(prior), params_.fmt);
-      if (!f.ok) {
-        e.stage_ms[size_t(Stage::curb_matching)] += watch.lap_ms();
-        e.health |= kCurbMatchRejected;
-        return;
-      }
-      t = f.correction;
-      break;
+      const FmtResult f = fmt_match(features_world, local_map.points(), xy(prior), params_.fmt);
+      if (!f.ok) return std::nullopt;
+      return f.correction;
     }
-    default:
-      return;
+    case LocalizerMethod::gps:
+    case LocalizerMethod::intensity:
+      break;  // no curb matcher: process_scan does not ask
   }
-  const Eigen::Vector2d corrected_xy = t.apply(xy(prior));
-  const Pose2d z{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t.yaw)};
-  const CurbMatchQuality q = curb_match_quality(features, z, local_map, local_tangents, params_.curb_noise);
-  e.curb_observation = z;
-  e.curb_inlier_ratio = q.inlier_ratio;
-  e.stage_ms[size_t(Stage::curb_matching)] += watch.lap_ms();
-  if (q.inlier_ratio < params_.health.min_inlier_ratio) {
-    e.health |= kCurbMatchRejected;
-    return;
-  }
-  Eigen::Vector3d innovation(z.x - prior.x, z.y - prior.y, wrap_angle(z.yaw - prior.yaw));
-  const Eigen::Matrix3d S = filter_->covariance() + q.covariance;
+  return std::nullopt;
+}
+
+// 3.3: the curb observation (x, y, psi) into KF2, if it passes the innovation gate.
+void Localizer::fuse_curbs(const CurbObservation& z, LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::fusion));
+  const Pose2d prior = filter_->pose();
+  const Eigen::Vector3d innovation(z.pose.x - prior.x, z.pose.y - prior.y, wrap_angle(z.pose.yaw - prior.yaw));
+  const Eigen::Matrix3d S = filter_->covariance() + z.covariance;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_curb, curb_rejections_)) {
     e.health |= kCurbMatchRejected;
     return;
   }
-  filter_->update_curb(Eigen::Vector3d(z.x, z.y, z.yaw), q.covariance);  // KF2
-  e.stage_ms[size_t(Stage::fusion)] += watch.lap_ms();
+  filter_->update_curb(Eigen::Vector3d(z.pose.x, z.pose.y, z.pose.yaw), z.covariance);  // KF2
 }
 
-void Localizer::match_intensity(const std::vector<Eigen::Vector3d>& ground, const std::vector<double>& intensities,
-                                LocalizerEstimate& e) {
-  Stopwatch watch;
-  const Pose2d prior = filter_->pose();
-  // The prior's spread along and across the car sets the search window (see aps_window_sigmas).
+// 3.2: APS of S against the intensity layer (Eq. 14-18) around the pose after the curb update; nullopt
+// (and why, in e.health) if there is no position to use.
+std::optional<ApsResult> Localizer::match_intensity(IntensityGrid& S, LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::intensity_matching));
+  // S holds vehicle-frame cells, so it goes where the curbs just put the car.
+  S.pose = filter_->pose();
+  const ApsResult aps = aps_match(S, map_.intensity, aps_window(S.pose));
+  e.intensity_cells = aps.cells_used;
+  if (!aps.ok) {
+    e.health |= kNoIntensityMatch;
+    return std::nullopt;
+  }
+  if (aps.peak_on_edge) {
+    e.health |= kIntensityMatchRejected;
+    return std::nullopt;
+  }
+  e.intensity_observation = aps.position;
+  return aps;
+}
+
+// APS's search window: section 3.2's, grown to aps_window_sigmas of the prior's spread along and across
+// the car, up to the maxima.
+ApsParams Localizer::aps_window(const Pose2d& prior) const {
   const double c = std::cos(prior.yaw), s = std::sin(prior.yaw);
   Eigen::Matrix2d to_vehicle;
   to_vehicle << c, s, -s, c;
   const Eigen::Matrix2d spread = to_vehicle * filter_->covariance().topLeftCorner<2, 2>() * to_vehicle.transpose();
-  ApsParams aps_params = params_.aps;
-  auto window = [&](double variance, double paper_range, double max_range) {
+  ApsParams aps = params_.aps;
+  auto range = [&](double variance, double paper_range, double max_range) {
     const double wanted = std::clamp(params_.aps_window_sigmas * std::sqrt(std::max(variance, 0.0)), paper_range,
                                      std::max(paper_range, max_range));
     // Whole steps, so the window stays symmetric about the prior.
-    return std::floor(wanted / aps_params.step_m + 1e-9) * aps_params.step_m;
+    return std::floor(wanted / aps.step_m + kWholeStepTolerance) * aps.step_m;
   };
-  aps_params.longitudinal_range_m =
-      window(spread(0, 0), params_.aps.longitudinal_range_m, params_.aps_max_longitudinal_range_m);
-  aps_params.lateral_range_m = window(spread(1, 1), params_.aps.lateral_range_m, params_.aps_max_lateral_range_m);
-  const IntensityGrid S = build_intensity_grid(ground, intensities, prior, params_.intensity_grid);  // Eq. 8
-  const ApsResult aps = aps_match(S, map_.intensity, aps_params);  // Eq. 14-18
-  e.intensity_cells = aps.cells_used;
-  e.stage_ms[size_t(Stage::intensity_matching)] += watch.lap_ms();
-  if (!aps.ok) {
-    e.health |= kNoIntensityMatch;
-    return;
-  }
-  if (aps.peak_on_edge) {
-    e.health |= kIntensityMatchRejected;
-    return;
-  }
-  e.intensity_observation = aps.position;
+  aps.longitudinal_range_m =
+      range(spread(0, 0), params_.aps.longitudinal_range_m, params_.aps_max_longitudinal_range_m);
+  aps.lateral_range_m = range(spread(1, 1), params_.aps.lateral_range_m, params_.aps_max_lateral_range_m);
+  return aps;
+}
+
+// 3.3: the APS position into KF2, if it passes the innovation gate; only along the road when the curbs
+// were matched in this scan (see aps_longitudinal_only_with_curbs).
+void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::fusion));
+  const Pose2d prior = filter_->pose();
   const Eigen::Vector2d innovation = aps.position - xy(prior);
   const Eigen::Matrix2d R = aps.covariance * params_.aps_covariance_scale;
-  const Eigen::Matrix2d S2 = filter_->covariance().topLeftCorner<2, 2>() + R;
-  if (!gate(innovation.dot(S2.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
+  const Eigen::Matrix2d S = filter_->covariance().topLeftCorner<2, 2>() + R;
+  if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
     e.health |= kIntensityMatchRejected;
     return;
   }
@@ -375,7 +459,16 @@ void Localizer::match_intensity(const std::vector<Eigen::Vector3d>& ground, cons
     filter_->update_intensity_along(aps.position, R, Eigen::Vector2d(std::cos(prior.yaw), std::sin(prior.yaw)));
   else
     filter_->update_intensity(aps.position, R);  // KF2
-  e.stage_ms[size_t(Stage::fusion)] += watch.lap_ms();
+}
+
+void Localizer::report_pose(LocalizerEstimate& e) const {
+  if (filter_) {
+    e.pose = filter_->pose();
+    e.covariance = filter_->covariance();
+  } else {
+    e.health |= kNotInitialized;
+    e.covariance = Eigen::Matrix3d::Identity() * kUnknownVariance;
+  }
 }
 
 }  // namespace lidarloop

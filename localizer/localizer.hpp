@@ -6,10 +6,10 @@
 // Per scan (paper sections 2-3, method `proposed`):
 //   predict to the scan's end with Eq. 19 from CAN -> de-skew the points with CAN odometry ->
 //   driving corridor from the curb map (2.1.1) -> ground plane and obstacles (2.1.2, Eq. 2-3) ->
-//   single-frame curbs, accumulated over frames (Eq. 4-5), minus those next to obstacles, beam model
-//   (Eq. 6-7) -> probabilistic ICP against the map (3.1) -> KF2 curb update (x, y, psi) ->
-//   grid S of the ground's intensities (Eq. 8) -> APS against the intensity layer (3.2) -> KF2
-//   intensity update (x, y).
+//   single-frame curbs, minus those next to obstacles, accumulated over frames (Eq. 4-5), beam model
+//   (Eq. 6-7) (2.2.1) -> grid S of the ground's intensities (2.2.2, Eq. 8) -> probabilistic ICP
+//   against the map (3.1) -> KF2 curb update (x, y, psi) (3.3) -> APS of S against the intensity
+//   layer around the updated pose (3.2) -> KF2 intensity update (x, y) (3.3).
 // GPS fixes update KF1 as they come. The baselines swap or drop the matching steps (LocalizerMethod).
 #include <array>
 #include <cstdint>
@@ -31,14 +31,14 @@ namespace lidarloop {
 
 // What is wrong, as bits: an estimate with none set is "ok".
 enum HealthFlag : uint32_t {
-  kNotInitialized = 1u << 0,   // no GPS fix yet: there is no pose to report
-  kCanGap = 1u << 1,           // no CAN for can_timeout: prediction holds the last speed and steering
-  kNoGps = 1u << 2,            // no fix for gps_timeout
-  kInvalidPoints = 1u << 3,    // the scan had NaN or infinite points (dropped)
-  kEmptyScan = 1u << 4,        // too few valid points to match
-  kNoCorridor = 1u << 5,       // no corridor around the pose (off the map?): all points used
-  kNoGroundPlane = 1u << 6,    // no plane fit: no obstacle removal this scan
-  kFewCurbs = 1u << 7,         // too few curb features: no curb observation (occluded curbs, open area)
+  kNotInitialized = 1u << 0,     // no GPS fix yet: there is no pose to report
+  kCanGap = 1u << 1,             // no CAN for can_timeout: prediction holds the last speed and steering
+  kNoGps = 1u << 2,              // no fix for gps_timeout
+  kInvalidPoints = 1u << 3,      // the scan had NaN or infinite points (dropped)
+  kEmptyScan = 1u << 4,          // too few valid points to match
+  kNoCorridor = 1u << 5,         // no corridor around the pose (off the map?): all points used
+  kNoGroundPlane = 1u << 6,      // no plane fit: no obstacle removal this scan
+  kFewCurbs = 1u << 7,           // too few curb features: no curb observation (occluded curbs, open area)
   kCurbMatchRejected = 1u << 8,  // the curb match disagreed with the filter or explained too few curbs
   kNoIntensityMatch = 1u << 9,   // APS had too few usable cells (off the intensity map, road hidden)
   kIntensityMatchRejected = 1u << 10,
@@ -48,13 +48,22 @@ constexpr int kHealthFlagCount = 11;
 std::string describe_health(uint32_t flags);
 
 // Wall time spent per stage of one scan, ms (zero for stages the method skips).
-enum class Stage { deskew, corridor, obstacles, curb_detection, curb_features, curb_matching, intensity_matching, fusion };
+enum class Stage {
+  deskew,
+  corridor,
+  obstacles,
+  curb_detection,
+  curb_features,
+  curb_matching,
+  intensity_matching,
+  fusion
+};
 constexpr int kStageCount = 8;
 const char* stage_name(Stage s);
 
 struct LocalizerEstimate {
-  int64_t stamp_ns = 0;  // the pose's time: the scan's last firing
-  Pose2d pose;           // rear axle, local frame of the map
+  int64_t stamp_ns = 0;                                      // the pose's time: the scan's last firing
+  Pose2d pose;                                               // rear axle, local frame of the map
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // x, y, psi
   uint32_t health = kNotInitialized;
 
@@ -102,11 +111,29 @@ class Localizer {
   const ScanFeatures& last_features() const { return features_; }
 
  private:
+  // The curb observation of KF2: the pose the curbs put the car at, and how well they pin it down.
+  struct CurbObservation {
+    Pose2d pose;
+    Eigen::Matrix3d covariance;
+  };
+
   void predict_to(int64_t t_ns);
   uint32_t input_health(int64_t t_ns) const;
-  void match_curbs(const std::vector<Eigen::Vector2d>& features, LocalizerEstimate& e);
-  void match_intensity(const std::vector<Eigen::Vector3d>& ground, const std::vector<double>& intensities,
-                       LocalizerEstimate& e);
+  // The stages of on_scan that use the localizer's state (the others are free functions in
+  // localizer.cpp); each records its diagnostics, health bits and time in `e`.
+  void process_scan(const PointCloud& cloud, LocalizerEstimate& e);
+  Pose2d motion_since_previous_scan();
+  std::vector<Eigen::Vector2d> curb_features(std::vector<Eigen::Vector2d> curbs,
+                                             const std::vector<Eigen::Vector2d>& obstacles, const Pose2d& motion,
+                                             LocalizerEstimate& e);
+  std::optional<CurbObservation> match_curbs(const std::vector<Eigen::Vector2d>& features, LocalizerEstimate& e);
+  std::optional<Pose2d> curb_correction(const std::vector<Eigen::Vector2d>& features_world, const MapIndex& local_map,
+                                        const Pose2d& prior);
+  void fuse_curbs(const CurbObservation& z, LocalizerEstimate& e);
+  std::optional<ApsResult> match_intensity(IntensityGrid& S, LocalizerEstimate& e);
+  ApsParams aps_window(const Pose2d& prior) const;
+  void fuse_intensity(const ApsResult& aps, LocalizerEstimate& e);
+  void report_pose(LocalizerEstimate& e) const;
   // The chi^2 gate, with the filter's doubt growing after max_rejections in a row (see
   // HealthParams); true: use the observation.
   bool gate(double mahalanobis_sq, double threshold, int& rejections);
@@ -119,7 +146,7 @@ class Localizer {
   MotionPredictor predictor_;
   Pose2d odometry_;  // dead reckoning from CAN alone: what the curb accumulation moves frames by
   std::optional<PoseFilter> filter_;
-  int64_t time_ns_ = 0;  // the time odometry and filter are predicted to
+  int64_t time_ns_ = 0;           // the time odometry and filter are predicted to
   double speed_ = 0, steer_ = 0;  // the last CAN frame's (held until the next)
   std::optional<int64_t> last_can_ns_, last_gps_ns_;
 

@@ -1,6 +1,7 @@
 // APS intensity matching (sections 2.2.2 and 3.2, Eq. 8 and 14-18): grid S binning, recovery of a
 // known offset on a crosswalk with the vehicle turned 30 degrees, the limit of the search window, a
-// broad distribution on a featureless road, and refusal of too little data or mismatched cells.
+// broad distribution on a featureless road, refusal of too little data or mismatched cells, and the
+// steps of the match on their own (search window, Eq. 14 in logs, peak on the edge, Eq. 15-16).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -153,7 +154,7 @@ std::string* Aps::asphalt_dir_ = nullptr;
 
 TEST(ApsGrid, BinsPointsAroundTheVehicleAndKeepsRunningStatistics) {
   const IntensityGridParams g;  // 200 x 200 at 0.2 m: +-20 m
-  const std::vector<Eigen::Vector3d> points{{0.1, 0.1, 0}, {0.15, 0.05, 0}, {0.19, 0.01, 0},
+  const std::vector<Eigen::Vector3d> points{{0.1, 0.1, 0},   {0.15, 0.05, 0},  {0.19, 0.01, 0},
                                             {-0.1, -0.1, 0}, {19.9, -19.9, 0}, {20.1, 0, 0}};
   const std::vector<double> values{10, 20, 30, 7, 5, 99};
   const IntensityGrid S = build_intensity_grid(points, values, Pose2d{}, g);
@@ -227,7 +228,8 @@ TEST_F(Aps, AFeaturelessRoadGivesABroadDistribution) {
 
   IntensityMap flat(*asphalt_dir_);
   const Scan flat_scan = scan_at(plain_asphalt, kTruth, g, 5);
-  const ApsResult r_flat = aps_match(build_intensity_grid(flat_scan.points, flat_scan.intensities, prior, g), flat, params);
+  const ApsResult r_flat =
+      aps_match(build_intensity_grid(flat_scan.points, flat_scan.intensities, prior, g), flat, params);
 
   IntensityMap marked(*crosswalk_dir_);
   const Scan marked_scan = scan_at(crosswalk, kTruth, g, 5);
@@ -274,6 +276,100 @@ TEST_F(Aps, TooFewUsableCellsGiveNoEstimate) {
       aps_match(build_intensity_grid(one_each, std::vector<double>(one_each.size(), kAsphalt), prior, g), map, params);
   EXPECT_FALSE(sparse.ok);
   EXPECT_EQ(sparse.cells_used, 0);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The steps of aps_match on their own
+
+TEST(ApsSteps, TheSearchWindowHasWholeStepsOfWholeCells) {
+  const ApsSearchWindow paper = aps_search_window(ApsParams{}, kResolution);  // +-3 m, +-1 m in 0.2 m steps
+  EXPECT_EQ(paper.nx, 15);
+  EXPECT_EQ(paper.ny, 5);
+  EXPECT_EQ(paper.step_cells, 1);
+  EXPECT_EQ(paper.offsets_x(), 31);
+  EXPECT_EQ(paper.offsets_y(), 11);
+  EXPECT_NEAR(paper.offset(0, 0).x(), -3.0, 1e-12);
+  EXPECT_NEAR(paper.offset(30, 10).y(), 1.0, 1e-12);
+
+  ApsParams coarse;
+  coarse.step_m = 0.4;                // two cells
+  coarse.longitudinal_range_m = 1.0;  // 2.5 steps: the half step is not searched
+  const ApsSearchWindow w = aps_search_window(coarse, kResolution);
+  EXPECT_EQ(w.step_cells, 2);
+  EXPECT_EQ(w.nx, 2);
+  EXPECT_EQ(w.margin_x(), 4);
+
+  ApsParams bad = coarse;
+  bad.step_m = 0.3;  // a cell and a half
+  EXPECT_THROW(aps_search_window(bad, kResolution), std::invalid_argument);
+  bad = coarse;
+  bad.lateral_range_m = -1;
+  EXPECT_THROW(aps_search_window(bad, kResolution), std::invalid_argument);
+}
+
+TEST(ApsSteps, LogProbabilitiesAreEq14sExponent) {
+  const std::vector<double> log_p = aps_log_probabilities({0.0f, 2.0f, 4.0f}, 0.5);
+  ASSERT_EQ(log_p.size(), 3u);
+  EXPECT_DOUBLE_EQ(log_p[0], 0.0);
+  EXPECT_DOUBLE_EQ(log_p[1], -0.5);
+  EXPECT_DOUBLE_EQ(log_p[2], -1.0);
+}
+
+// A 5 x 3 window of 0.2 m steps: offsets -0.4..0.4 m along x, -0.2..0.2 m along y.
+ApsSearchWindow small_window() {
+  ApsParams p;
+  p.longitudinal_range_m = 0.4;
+  p.lateral_range_m = 0.2;
+  return aps_search_window(p, kResolution);
+}
+
+TEST(ApsSteps, OneCertainOffsetIsTheEstimateToWithinAStep) {
+  const ApsSearchWindow w = small_window();
+  std::vector<double> log_p(size_t(w.offsets_x() * w.offsets_y()), -1e4);  // exp() of these is 0
+  log_p[size_t(1 * w.offsets_x() + 3)] = 0;                                // offset (0.2, 0) m
+  const OffsetMoments m = aps_offset_moments(log_p, w);
+  EXPECT_NEAR(m.mean.x(), 0.2, 1e-12);
+  EXPECT_NEAR(m.mean.y(), 0.0, 1e-12);
+  const double quantisation = 0.2 * 0.2 / 12;  // a uniform spread over one step
+  EXPECT_NEAR(m.covariance(0, 0), quantisation, 1e-12);
+  EXPECT_NEAR(m.covariance(1, 1), quantisation, 1e-12);
+  EXPECT_NEAR(m.covariance(0, 1), 0.0, 1e-12);
+  EXPECT_FALSE(aps_peak_on_edge(log_p, w));
+}
+
+TEST(ApsSteps, AFlatDistributionIsCentredAndAsWideAsTheWindow) {
+  const ApsSearchWindow w = small_window();
+  const std::vector<double> log_p(size_t(w.offsets_x() * w.offsets_y()), -7.0);
+  const OffsetMoments m = aps_offset_moments(log_p, w);
+  EXPECT_NEAR(m.mean.norm(), 0.0, 1e-12);
+  // Variance of k * step over k in -n..n, uniform: step^2 n (n + 1) / 3; plus the step's quantisation.
+  const double step2 = 0.2 * 0.2;
+  EXPECT_NEAR(m.covariance(0, 0), step2 * 2 * 3 / 3 + step2 / 12, 1e-12);
+  EXPECT_NEAR(m.covariance(1, 1), step2 * 1 * 2 / 3 + step2 / 12, 1e-12);
+  EXPECT_NEAR(m.covariance(0, 1), 0.0, 1e-12);
+}
+
+TEST(ApsSteps, APeakOnTheBorderIsOnTheEdgeOnlyAlongAnAxisThatIsSearched) {
+  const ApsSearchWindow w = small_window();
+  const size_t n = size_t(w.offsets_x() * w.offsets_y());
+  auto peak_at = [&](int i, int j) {
+    std::vector<double> log_p(n, -1.0);
+    log_p[size_t(j * w.offsets_x() + i)] = 0;
+    return log_p;
+  };
+  EXPECT_FALSE(aps_peak_on_edge(peak_at(2, 1), w));
+  EXPECT_TRUE(aps_peak_on_edge(peak_at(0, 1), w));
+  EXPECT_TRUE(aps_peak_on_edge(peak_at(4, 1), w));
+  EXPECT_TRUE(aps_peak_on_edge(peak_at(2, 0), w));
+  EXPECT_TRUE(aps_peak_on_edge(peak_at(2, 2), w));
+
+  ApsParams along_only;
+  along_only.longitudinal_range_m = 0.4;
+  along_only.lateral_range_m = 0;  // one row of offsets: its border is its middle
+  const ApsSearchWindow row = aps_search_window(along_only, kResolution);
+  std::vector<double> log_p(size_t(row.offsets_x()), -1.0);
+  log_p[2] = 0;
+  EXPECT_FALSE(aps_peak_on_edge(log_p, row));
 }
 
 TEST_F(Aps, GridCellsMustBeTheMapsCells) {

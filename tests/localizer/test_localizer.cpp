@@ -1,16 +1,20 @@
 // The localizer as a whole, on a synthetic straight road whose truth is known exactly: curbs at
 // y = +-4.5 m (15 cm high), a dashed centre line and zebra crossings in the intensity layer. The GPS
 // is biased by a known offset; the curbs must remove its lateral part and the paint its longitudinal
-// part. Then the bad days: NaN points, empty scans, no curbs, a minute without GPS, CAN gaps.
+// part. Then the bad days: NaN points, empty scans, no curbs, a minute without GPS, CAN gaps; and
+// the per-stage timing of a scan.
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <thread>
 
 #include <unistd.h>
 
 #include <gtest/gtest.h>
 
 #include "localizer/localizer.hpp"
+#include "localizer/stage_timer.hpp"
 
 namespace lidarloop {
 namespace {
@@ -46,7 +50,6 @@ HdMap synthetic_map() {
   builder.save(dir);
   return HdMap{CurbLayer(curbs), IntensityMap(dir)};
 }
-
 
 // A 10 Hz scan of 16 downward lasers from a car driving along y = lateral at kSpeed, each point cast
 // from the sensor's position at its own firing time (so de-skew has real distortion to remove).
@@ -97,7 +100,7 @@ LocalizerParams test_params() {
 struct DriveOptions {
   double duration_s = 6;
   Eigen::Vector2d gps_bias{-1.5, 1.2};  // m, east and north: the known offset to remove
-  double lateral = -2.0;                 // the car's true y (right-hand lane)
+  double lateral = -2.0;                // the car's true y (right-hand lane)
   int azimuth_steps = 900;
   std::function<bool(int64_t)> gps_up = [](int64_t) { return true; };
   std::function<bool(int64_t)> can_up = [](int64_t) { return true; };
@@ -246,7 +249,8 @@ TEST(Localizer, AMinuteWithoutGpsIsReportedAndSurvived) {
   const auto& [e, truth] = run.back();
   EXPECT_TRUE(e.health & kNoGps);
   // Between crossings the dashes alone may not be enough for APS; nothing else may be wrong.
-  EXPECT_EQ(e.health & ~uint32_t(kNoGps | kIntensityMatchRejected | kNoIntensityMatch), 0u) << describe_health(e.health);
+  EXPECT_EQ(e.health & ~uint32_t(kNoGps | kIntensityMatchRejected | kNoIntensityMatch), 0u)
+      << describe_health(e.health);
   std::cout << "[ figures  ] after 62 s without GPS: error (" << e.pose.x - truth.x << ", " << e.pose.y - truth.y
             << ") m\n";
   EXPECT_NEAR(e.pose.y, truth.y, 0.05);
@@ -269,6 +273,32 @@ TEST(Localizer, CanGapsAreReportedAndInflateTheCovariance) {
   }
   EXPECT_TRUE(saw_gap);
   EXPECT_FALSE(run.back().first.health & kCanGap);
+}
+
+TEST(StageTimer, AddsTheScopesWallTimeToItsField) {
+  double ms = 5.0;  // a stage run in pieces sums up
+  {
+    const StageTimer timer(ms);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_GE(ms, 7.0);
+}
+
+TEST(Localizer, EveryStageIsTimedWithinTheScansTotal) {
+  Localizer localizer(shared_map(), test_params());
+  DriveOptions o;
+  o.duration_s = 2;
+  const auto run = drive(localizer, o);
+  ASSERT_FALSE(run.empty());
+  for (const auto& [e, truth] : run) {
+    double stages = 0;
+    for (double ms : e.stage_ms) stages += ms;
+    EXPECT_LE(stages, e.total_ms + 1e-6);  // the stages do not overlap
+  }
+  const LocalizerEstimate& last = run.back().first;
+  ASSERT_EQ(last.health, 0u) << describe_health(last.health);
+  for (int s = 0; s < kStageCount; ++s)  // the proposed method runs them all
+    EXPECT_GT(last.stage_ms[size_t(s)], 0.0) << stage_name(Stage(s));
 }
 
 TEST(LocalizerParams, ReadsOverridesAndRejectsUnknownKeys) {
