@@ -62,11 +62,21 @@ std::string xml_escaped(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
       default:
         // XML 1.0 forbids most control characters even when escaped.
         out += (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') ? '?' : c;
@@ -132,7 +142,9 @@ std::string metrics_json(const Metrics& m) {
   return doc.dump(kJsonIndent) + "\n";
 }
 
-void write_metrics_json(const std::string& path, const Metrics& metrics) { write_text_file(path, metrics_json(metrics)); }
+void write_metrics_json(const std::string& path, const Metrics& metrics) {
+  write_text_file(path, metrics_json(metrics));
+}
 
 void write_errors_csv(const std::string& path, const ScoredRun& run, const std::vector<EstimateRecord>& estimates) {
   std::string text =
@@ -145,10 +157,9 @@ void write_errors_csv(const std::string& path, const ScoredRun& run, const std::
     auto sigma = [&](int k) { return std::sqrt(std::max(0.0, est.covariance(k, k))); };
     text += seconds(e.stamp_ns) + ',' + number(e.lateral_m) + ',' + number(e.longitudinal_m) + ',' +
             number(e.heading_rad * kDegPerRad) + ',' + number(e.position_m) + ',' + number(e.estimate.x) + ',' +
-            number(e.estimate.y) + ',' + number(e.estimate.yaw) + ',' + number(e.truth.x) + ',' +
-            number(e.truth.y) + ',' + number(e.truth.yaw) + ',' + csv_field(est.status) + ',' +
-            number(est.latency_ms) + ',' + number(sigma(0)) + ',' + number(sigma(1)) + ',' +
-            number(sigma(2) * kDegPerRad) + '\n';
+            number(e.estimate.y) + ',' + number(e.estimate.yaw) + ',' + number(e.truth.x) + ',' + number(e.truth.y) +
+            ',' + number(e.truth.yaw) + ',' + csv_field(est.status) + ',' + number(est.latency_ms) + ',' +
+            number(sigma(0)) + ',' + number(sigma(1)) + ',' + number(sigma(2) * kDegPerRad) + '\n';
   }
   write_text_file(path, text);
 }
@@ -156,8 +167,7 @@ void write_errors_csv(const std::string& path, const ScoredRun& run, const std::
 std::string tum_line(int64_t stamp_ns, const Pose2d& pose) {
   // A rotation by yaw about z: q = (0, 0, sin(yaw/2), cos(yaw/2)).
   const double qz = std::sin(pose.yaw / 2), qw = std::cos(pose.yaw / 2);
-  return seconds(stamp_ns) + ' ' + number(pose.x) + ' ' + number(pose.y) + " 0 0 0 " + number(qz) + ' ' +
-         number(qw);
+  return seconds(stamp_ns) + ' ' + number(pose.x) + ' ' + number(pose.y) + " 0 0 0 " + number(qz) + ' ' + number(qw);
 }
 
 static const char* const kTumHeader = "# timestamp x y z qx qy qz qw\n";
@@ -188,8 +198,8 @@ std::string junit_xml(const std::vector<Metrics>& runs) {
     size_t tests = 0, failures = 0;
     for (const auto& m : runs)
       if (m.scenario == scenario) tests++, failures += m.pass ? 0 : 1;
-    xml += "  <testsuite name=\"" + xml_escaped(scenario) + "\" tests=\"" + std::to_string(tests) +
-           "\" failures=\"" + std::to_string(failures) + "\" errors=\"0\">\n";
+    xml += "  <testsuite name=\"" + xml_escaped(scenario) + "\" tests=\"" + std::to_string(tests) + "\" failures=\"" +
+           std::to_string(failures) + "\" errors=\"0\">\n";
     for (const auto& m : runs) {
       if (m.scenario != scenario) continue;
       xml += "    <testcase name=\"" + xml_escaped(m.method) + "\" classname=\"lidarloop." + xml_escaped(scenario) +
@@ -211,10 +221,11 @@ std::string comparison_markdown(const std::vector<Metrics>& runs) {
   bool several_scenarios = false;
   for (const auto& m : runs) several_scenarios |= m.scenario != runs.front().scenario;
   const std::string first = several_scenarios ? "| scenario " : "";
-  std::string md = first +
-                   "| method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | max error m | latency p50 ms | "
-                   "pass |\n" +
-                   (several_scenarios ? "|---" : "") + "|---|---:|---:|---:|---:|---:|:---:|\n";
+  std::string md =
+      first +
+      "| method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | max error m | latency p50 ms | "
+      "pass |\n" +
+      (several_scenarios ? "|---" : "") + "|---|---:|---:|---:|---:|---:|:---:|\n";
   for (const auto& m : runs) {
     if (several_scenarios) md += "| " + markdown_cell(m.scenario) + ' ';
     md += "| " + markdown_cell(m.method) + " | " + cell(m.lateral_rmse_m, "%.3f") + " | " +

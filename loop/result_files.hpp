@@ -1,8 +1,8 @@
 #pragma once
-// The files a run leaves behind (DESIGN.md "Files": results): metrics.json for machines, errors.csv
-// per frame, TUM trajectories for evo, JUnit XML for CI, and the comparison table of `lidarloop
-// compare` (markdown for people, CSV for spreadsheets). Every writer throws InputError naming the
-// path when the file cannot be written.
+// The files a run's results leave behind, written from what the pure scorer (loop/scorer.hpp)
+// returned: metrics.json for machines, errors.csv per frame, TUM trajectories for evo, JUnit XML for
+// CI, and the comparison table of `lidarloop compare` (markdown for people, CSV for spreadsheets).
+// Every writer throws InputError naming the path when the file cannot be written.
 #include <string>
 #include <vector>
 

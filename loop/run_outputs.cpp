@@ -1,6 +1,5 @@
 #include "loop/run_outputs.hpp"
 
-#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -48,27 +47,15 @@ std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate
   return out;
 }
 
-double max_lane_offset(const std::vector<TruthSample>& truth, const Path& route) {
-  double worst = 0, s = 0;
-  constexpr double kSearch = 30.0;  // m along the route around the previous projection
-  for (size_t i = 0; i < truth.size(); ++i) {
-    const Eigen::Vector2d p(truth[i].pose.x, truth[i].pose.y);
-    s = i == 0 ? route.project(p) : route.project(p, std::max(0.0, s - kSearch), std::min(route.length, s + kSearch));
-    const Pose2d on = route.pose_at(s);
-    worst = std::max(worst, std::abs(-std::sin(on.yaw) * (p.x() - on.x) + std::cos(on.yaw) * (p.y() - on.y)));
-  }
-  return worst;
-}
-
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthSample>& truth_samples, const std::string& method,
                           const std::vector<LocalizerEstimate>& all_estimates, const WorstFrame* worst,
                           const HdMap& map) {
-  std::filesystem::create_directories(dir);
   const std::vector<EstimateRecord> estimates = estimate_records(all_estimates);
   const std::vector<TruthPose> truth = truth_poses(truth_samples);
-  ScoredRun scored = score(truth, estimates, scenario.pass, method, scenario_name);
-  score_lane_keeping(scored.metrics, max_lane_offset(truth_samples, route));
+  ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name);
+
+  std::filesystem::create_directories(dir);
   write_metrics_json(dir + "/metrics.json", scored.metrics);
   write_errors_csv(dir + "/errors.csv", scored, estimates);
   write_tum(dir + "/estimate.tum", estimates);

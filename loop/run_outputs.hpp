@@ -10,15 +10,15 @@
 
 namespace lidarloop {
 
+// The scorer's plain inputs from the loop's records. The truth's stamped poses (the scorer needs no
+// speeds or steering):
 std::vector<TruthPose> truth_poses(const std::vector<TruthSample>& truth);
-// Estimates of an initialised localizer, with the health as words and the latency.
+// The estimates of an initialised localizer, with the health as words and the latency:
 std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate>& estimates);
 
-// The true pose's largest distance from the lane centre the ego was told to follow.
-double max_lane_offset(const std::vector<TruthSample>& truth, const Path& route);
-
-// Scores one method's run (thresholds, settle time and lane keeping from the scenario) and writes its
-// files into `dir`. `worst` may be null (no bird's-eye picture).
+// Scores one method's run with the pure scorer (loop/scorer.hpp: the thresholds and settle time from
+// the scenario, lane keeping along `route`), then writes its files into `dir`. `worst` may be null (no
+// bird's-eye picture).
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthSample>& truth, const std::string& method,
                           const std::vector<LocalizerEstimate>& estimates, const WorstFrame* worst, const HdMap& map);

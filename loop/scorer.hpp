@@ -1,7 +1,17 @@
 #pragma once
-// Scores a localizer's estimates against ground truth, per DESIGN.md: errors in the ground-truth
-// vehicle frame at each estimate's stamp, no trajectory alignment; RMSEs, maxima and latency
-// percentiles; pass / fail against a scenario's thresholds.
+// Scoring as a pure function: from the trajectories (the ground truth, the localizer's estimates and
+// the route the ego was told to follow) and a scenario's thresholds to metrics, per-frame errors and
+// a verdict. Nothing here writes files, prints or keeps state; loop/result_files, loop/error_plots
+// and loop/run_outputs write what it returns.
+//
+// The error convention. Each estimate is compared with the truth interpolated at the estimate's
+// stamp, in the ground-truth vehicle frame (x forward, y left), with (dx, dy) the estimate's position
+// minus the truth's:
+//   e_long = cos(psi_gt) dx + sin(psi_gt) dy    positive: ahead of the truth
+//   e_lat  = -sin(psi_gt) dx + cos(psi_gt) dy   positive: to its left
+//   e_yaw  = wrap(psi_est - psi_gt)             positive: turned counter-clockwise from it
+// There is no trajectory alignment: the localizer estimates in the map's frame, which is the truth's,
+// so an offset between the two is an error to report, not a nuisance to fit away.
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -11,9 +21,12 @@
 #include <Eigen/Core>
 
 #include "common/vehicle_messages.hpp"
+#include "sim/path.hpp"
 #include "sim/scenario.hpp"
 
 namespace lidarloop {
+
+// ---- What goes in (besides the route, a sim/path.hpp Path, and the scenario's PassThresholds) ----
 
 // Ground truth, typically 100 Hz, sorted by stamp.
 using TruthPose = PoseStamped;
@@ -24,25 +37,68 @@ struct EstimateRecord {
   Pose2d pose;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // x, y (m), yaw (rad)
   std::string status;                                    // the method's own word ("tracking", "gps only", ...)
-  double latency_ms = 0;                                  // wall time the localizer spent on this frame
+  double latency_ms = 0;                                 // wall time the localizer spent on this frame
 };
 
-// The error of one estimate, in the ground-truth vehicle frame (x forward, y left): positive
-// longitudinal = ahead of the truth, positive lateral = to its left, positive heading = turned
-// counter-clockwise from it. The poses compared are kept for files and plots.
+// ---- What comes out ----
+
+// The error of one estimate, by the convention above. The poses compared are kept for files and plots.
 struct FrameError {
   int64_t stamp_ns = 0;
   double lateral_m = 0, longitudinal_m = 0, heading_rad = 0, position_m = 0;
   Pose2d truth, estimate;
 };
 
-// DESIGN.md's formulas; stamp_ns is left 0 for the caller to set.
+struct Metrics {
+  std::string method, scenario;
+  size_t frames = 0;           // estimates scored
+  size_t unscored_frames = 0;  // estimates outside the truth's time range (not scored, reported)
+  size_t settling_frames = 0;  // estimates within thresholds.settle_s of the first (not scored)
+  double lateral_rmse_m = 0, longitudinal_rmse_m = 0, heading_rmse_deg = 0, position_rmse_m = 0;
+  double max_position_error_m = 0, max_lateral_m = 0, max_longitudinal_m = 0, max_heading_deg = 0;  // absolute
+  int64_t worst_frame_stamp_ns = 0;  // the frame with the largest position error (for a bird's-eye plot)
+  double latency_p50_ms = 0, latency_p99_ms = 0, latency_max_ms = 0;  // over every estimate
+  // The truth's largest distance from the route (its lane's centre) over the whole run; NaN without truth.
+  double max_lane_offset_m = std::numeric_limits<double>::quiet_NaN();
+  PassThresholds thresholds;
+  bool pass = false;
+  std::vector<std::string> failures;  // for people, e.g. "lateral RMSE 0.310 m > 0.200 m"
+};
+
+struct ScoredRun {
+  Metrics metrics;
+  std::vector<FrameError> errors;      // one per scored estimate, in the estimates' order
+  std::vector<size_t> estimate_index;  // errors[i] belongs to estimates[estimate_index[i]]
+};
+
+// ---- The scorer ----
+
+// Scores every estimate whose stamp lies within the truth's time range and after the settling time,
+// and measures the truth's lane keeping along `route`. `method` and `scenario` only label the metrics.
+// Passes when there is at least one scored frame and every threshold that is set holds (a non-finite
+// value never holds). Throws std::invalid_argument if the truth is not sorted by stamp or the route
+// has fewer than two points.
+ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates, const Path& route,
+                const PassThresholds& thresholds, const std::string& method, const std::string& scenario);
+
+// ---- Its parts, pure as well ----
+
+// The error of `estimate` against `truth` by the convention above; stamp_ns is left 0 for the caller.
 FrameError frame_error(const Pose2d& truth, const Pose2d& estimate);
 
 // Truth at t by linear interpolation between the bracketing samples, the yaw interpolated along the
 // shorter arc. `truth` must be sorted by stamp. Throws std::out_of_range if t lies outside
 // [first stamp, last stamp] or truth is empty: extrapolating would invent a ground truth.
 Pose2d truth_at(const std::vector<TruthPose>& truth, int64_t t_ns);
+
+// Each truth sample's signed distance from `route` (positive = left of its direction of travel),
+// measured square to the route at the sample's projection. The projection follows the car along the
+// route from where the previous sample was, so it cannot jump to another stretch that passes nearby;
+// on a closed route its arc length runs on unwrapped, lap after lap, as the car's does; an open route
+// ends where it ends (beyond it, the distance is to the line of its last segment). The first sample
+// is projected onto the whole route. Throws std::invalid_argument if the route has fewer than two
+// points.
+std::vector<double> lane_offsets(const std::vector<TruthPose>& truth, const Path& route);
 
 // Root mean square; NaN for an empty list (there is nothing to measure, and 0 would read as perfect).
 double rmse(const std::vector<double>& values);
@@ -51,36 +107,5 @@ double rmse(const std::vector<double>& values);
 // than or equal to it, i.e. sorted[ceil(percent / 100 * n) - 1] (the first value for percent = 0).
 // Always one of the values, never an interpolation. NaN for an empty list.
 double percentile_nearest_rank(std::vector<double> values, double percent);
-
-struct Metrics {
-  std::string method, scenario;
-  size_t frames = 0;            // estimates scored
-  size_t unscored_frames = 0;   // estimates outside the truth's time range (not scored, reported)
-  size_t settling_frames = 0;   // estimates within thresholds.settle_s of the first (not scored)
-  double lateral_rmse_m = 0, longitudinal_rmse_m = 0, heading_rmse_deg = 0, position_rmse_m = 0;
-  double max_position_error_m = 0, max_lateral_m = 0, max_longitudinal_m = 0, max_heading_deg = 0;  // absolute
-  int64_t worst_frame_stamp_ns = 0;  // the frame with the largest position error (for a bird's-eye plot)
-  double latency_p50_ms = 0, latency_p99_ms = 0, latency_max_ms = 0;  // over every estimate
-  double max_lane_offset_m = std::numeric_limits<double>::quiet_NaN();  // set by score_lane_keeping
-  PassThresholds thresholds;
-  bool pass = false;
-  std::vector<std::string> failures;  // for people, e.g. "lateral RMSE 0.310 m > 0.200 m"
-};
-
-struct ScoredRun {
-  Metrics metrics;
-  std::vector<FrameError> errors;     // one per scored estimate, in the estimates' order
-  std::vector<size_t> estimate_index; // errors[i] belongs to estimates[estimate_index[i]]
-};
-
-// Scores every estimate whose stamp lies within the truth's time range. Passes when there is at
-// least one scored frame and every threshold that is set holds (a non-finite value never holds).
-// Throws std::invalid_argument if the truth is not sorted by stamp.
-// The car's largest distance from its lane's centre (closed loop), checked against
-// thresholds.max_lane_offset_m; updates pass and failures.
-void score_lane_keeping(Metrics& metrics, double max_lane_offset_m);
-
-ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates,
-                const PassThresholds& thresholds, const std::string& method, const std::string& scenario);
 
 }  // namespace lidarloop

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/input_error.hpp"
+#include "common/units.hpp"
 #include "loop/error_plots.hpp"
 #include "loop/result_files.hpp"
 #include "loop/scorer.hpp"
@@ -22,7 +23,6 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kEps = 1e-12;
 constexpr int64_t kMs = 1'000'000;
 
-// A straight drive east at 10 m/s, 100 Hz, for `seconds`.
 // Every error threshold at `value` (lane keeping and settling unset).
 PassThresholds thresholds_at(double value) {
   PassThresholds t;
@@ -30,6 +30,14 @@ PassThresholds thresholds_at(double value) {
   return t;
 }
 
+// The lane the straight truth below drives along, `lateral` m to its left: open, and longer than any
+// drive here.
+Path straight_route(double lateral = 0) {
+  constexpr double kLength = 1000;  // m
+  return make_path({{0, lateral}, {kLength, lateral}}, false);
+}
+
+// A straight drive east at 10 m/s, 100 Hz, for `seconds`.
 std::vector<TruthPose> straight_truth(double seconds) {
   std::vector<TruthPose> truth;
   for (int64_t t = 0; t <= int64_t(seconds * 1000) * kMs; t += 10 * kMs)
@@ -124,7 +132,8 @@ TEST(TruthAt, ThrowsOutsideRangeOrEmpty) {
 }
 
 TEST(Score, RmseOfConstantKnownErrors) {
-  const ScoredRun run = score(straight_truth(5), offset_estimates(5, 0.3, -0.2, 0.01), {}, "test", "straight");
+  const ScoredRun run =
+      score(straight_truth(5), offset_estimates(5, 0.3, -0.2, 0.01), straight_route(), {}, "test", "straight");
   const Metrics& m = run.metrics;
   EXPECT_EQ(m.frames, 51u);
   EXPECT_EQ(run.errors.size(), 51u);
@@ -134,14 +143,14 @@ TEST(Score, RmseOfConstantKnownErrors) {
   EXPECT_NEAR(m.max_position_error_m, std::hypot(0.3, 0.2), 1e-9);
   EXPECT_NEAR(m.max_lateral_m, 0.2, 1e-9);
   EXPECT_NEAR(run.errors.front().lateral_m, -0.2, 1e-9);  // to the right: negative
-  EXPECT_TRUE(m.pass);  // no thresholds set
+  EXPECT_TRUE(m.pass);                                    // no thresholds set
   EXPECT_TRUE(m.failures.empty());
 }
 
 TEST(Score, RmseOfAlternatingErrors) {
   std::vector<EstimateRecord> est = offset_estimates(1, 0, 0, 0);
   for (size_t i = 0; i < est.size(); ++i) est[i].pose.y = (i % 2 ? 0.3 : -0.3);
-  EXPECT_NEAR(score(straight_truth(1), est, {}, "m", "s").metrics.lateral_rmse_m, 0.3, 1e-9);
+  EXPECT_NEAR(score(straight_truth(1), est, straight_route(), {}, "m", "s").metrics.lateral_rmse_m, 0.3, 1e-9);
   EXPECT_NEAR(rmse({3, 4}), std::sqrt(12.5), kEps);
   EXPECT_TRUE(std::isnan(rmse({})));
 }
@@ -163,7 +172,7 @@ TEST(Score, NearestRankPercentiles) {
   std::vector<EstimateRecord> est = offset_estimates(9.9, 0, 0, 0);  // 100 frames
   ASSERT_EQ(est.size(), 100u);
   for (size_t i = 0; i < est.size(); ++i) est[i].latency_ms = double(i + 1);
-  const Metrics m = score(straight_truth(10), est, {}, "m", "s").metrics;
+  const Metrics m = score(straight_truth(10), est, straight_route(), {}, "m", "s").metrics;
   EXPECT_EQ(m.latency_p50_ms, 50);
   EXPECT_EQ(m.latency_p99_ms, 99);
   EXPECT_EQ(m.latency_max_ms, 100);
@@ -173,10 +182,10 @@ TEST(Score, EachThresholdTripsOnItsOwn) {
   const auto truth = straight_truth(3);
   const auto est = offset_estimates(3, 0.3, 0.2, 0.01);  // 0.2 m lateral, 0.3 m long, 0.573 deg, 0.361 m
   const PassThresholds loose = thresholds_at(1.0);
-  EXPECT_TRUE(score(truth, est, loose, "m", "s").metrics.pass);
+  EXPECT_TRUE(score(truth, est, straight_route(), loose, "m", "s").metrics.pass);
 
   auto trip = [&](PassThresholds t, const std::string& expected) {
-    const Metrics m = score(truth, est, t, "m", "s").metrics;
+    const Metrics m = score(truth, est, straight_route(), t, "m", "s").metrics;
     EXPECT_FALSE(m.pass) << expected;
     ASSERT_EQ(m.failures.size(), 1u) << expected;
     EXPECT_EQ(m.failures[0], expected);
@@ -196,7 +205,7 @@ TEST(Score, EachThresholdTripsOnItsOwn) {
 }
 
 TEST(Score, NoEstimatesFails) {
-  const Metrics m = score(straight_truth(1), {}, {}, "m", "s").metrics;
+  const Metrics m = score(straight_truth(1), {}, straight_route(), {}, "m", "s").metrics;
   EXPECT_EQ(m.frames, 0u);
   EXPECT_FALSE(m.pass);
   ASSERT_EQ(m.failures.size(), 1u);
@@ -205,17 +214,17 @@ TEST(Score, NoEstimatesFails) {
 
 TEST(Score, EstimatesOutsideTruthAreCountedNotScored) {
   auto est = offset_estimates(2, 0.1, 0, 0);
-  const Metrics m = score(straight_truth(1), est, {}, "m", "s").metrics;
+  const Metrics m = score(straight_truth(1), est, straight_route(), {}, "m", "s").metrics;
   EXPECT_EQ(m.frames, 11u);
   EXPECT_EQ(m.unscored_frames, 10u);
   EXPECT_TRUE(m.pass);
-  EXPECT_FALSE(score({}, est, {}, "m", "s").metrics.pass);
+  EXPECT_FALSE(score({}, est, straight_route(), {}, "m", "s").metrics.pass);
 }
 
 TEST(Score, DivergedEstimateFails) {
   auto est = offset_estimates(1, 0, 0, 0);
   est[3].pose.x = std::nan("");
-  const Metrics m = score(straight_truth(1), est, thresholds_at(1.0), "m", "s").metrics;
+  const Metrics m = score(straight_truth(1), est, straight_route(), thresholds_at(1.0), "m", "s").metrics;
   EXPECT_FALSE(m.pass);
 }
 
@@ -223,7 +232,9 @@ TEST(ResultFiles, MetricsJsonRoundTrip) {
   PassThresholds t;
   t.lateral_rmse_m = 0.1;
   t.heading_rmse_deg = 0.3;
-  const Metrics m = score(straight_truth(2), offset_estimates(2, 0.3, 0.2, 0.01, 7.5), t, "proposed", "dyn").metrics;
+  const Metrics m =
+      score(straight_truth(2), offset_estimates(2, 0.3, 0.2, 0.01, 7.5), straight_route(), t, "proposed", "dyn")
+          .metrics;
   const std::string path = temp_path("metrics.json");
   write_metrics_json(path, m);
   const auto j = nlohmann::json::parse(read_all(path));
@@ -242,9 +253,10 @@ TEST(ResultFiles, MetricsJsonRoundTrip) {
   ASSERT_EQ(j["failures"].size(), 2u);
   EXPECT_EQ(j["failures"][0], m.failures[0]);
 
-  // Undefined values (no frames) are null, not an invalid NaN token.
-  const auto empty = nlohmann::json::parse(metrics_json(score({}, {}, {}, "gps", "s").metrics));
+  // Undefined values (no frames, no truth) are null, not an invalid NaN token.
+  const auto empty = nlohmann::json::parse(metrics_json(score({}, {}, straight_route(), {}, "gps", "s").metrics));
   EXPECT_TRUE(empty["lateral_rmse_m"].is_null());
+  EXPECT_TRUE(empty["max_lane_offset_m"].is_null());
 }
 
 TEST(ResultFiles, TumLineFormat) {
@@ -275,16 +287,16 @@ TEST(ResultFiles, JunitHasFailureExactlyWhenFailing) {
   PassThresholds t;
   t.lateral_rmse_m = 0.1;
   const auto truth = straight_truth(1);
-  const Metrics good = score(truth, offset_estimates(1, 0, 0.05, 0), t, "proposed", "a<&>\"b").metrics;
-  const Metrics bad = score(truth, offset_estimates(1, 0, 0.5, 0), t, "icp", "a<&>\"b").metrics;
-  const Metrics other = score(truth, offset_estimates(1, 0, 0.05, 0), t, "gps", "static").metrics;
+  const Metrics good =
+      score(truth, offset_estimates(1, 0, 0.05, 0), straight_route(), t, "proposed", "a<&>\"b").metrics;
+  const Metrics bad = score(truth, offset_estimates(1, 0, 0.5, 0), straight_route(), t, "icp", "a<&>\"b").metrics;
+  const Metrics other = score(truth, offset_estimates(1, 0, 0.05, 0), straight_route(), t, "gps", "static").metrics;
   const std::string pass_xml = junit_xml({good, other});
   EXPECT_EQ(pass_xml.find("<failure"), std::string::npos);
   const std::string xml = junit_xml({good, bad, other});
   EXPECT_NE(xml.find("<failure message=\"lateral RMSE 0.500 m &gt; 0.100 m\""), std::string::npos) << xml;
   EXPECT_EQ(xml.find("<failure"), xml.rfind("<failure"));  // only one
-  EXPECT_NE(xml.find("<testsuite name=\"a&lt;&amp;&gt;&quot;b\" tests=\"2\" failures=\"1\""), std::string::npos)
-      << xml;
+  EXPECT_NE(xml.find("<testsuite name=\"a&lt;&amp;&gt;&quot;b\" tests=\"2\" failures=\"1\""), std::string::npos) << xml;
   EXPECT_NE(xml.find("<testsuite name=\"static\" tests=\"1\" failures=\"0\""), std::string::npos);
   EXPECT_EQ(xml.find("a<&>"), std::string::npos);
   write_junit(temp_path("junit.xml"), {good, bad});
@@ -294,11 +306,13 @@ TEST(ResultFiles, ComparisonTableAndCsv) {
   const auto truth = straight_truth(1);
   PassThresholds t;
   t.lateral_rmse_m = 0.1;
-  const std::vector<Metrics> runs = {score(truth, offset_estimates(1, 0.1, 0.05, 0), t, "proposed", "s").metrics,
-                                     score(truth, offset_estimates(1, 2.5, 0.5, 0), t, "icp", "s").metrics};
+  const std::vector<Metrics> runs = {
+      score(truth, offset_estimates(1, 0.1, 0.05, 0), straight_route(), t, "proposed", "s").metrics,
+      score(truth, offset_estimates(1, 2.5, 0.5, 0), straight_route(), t, "icp", "s").metrics};
   const std::string md = comparison_markdown(runs);
-  EXPECT_NE(md.find("| method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | max error m | latency p50 ms"),
-            std::string::npos);
+  EXPECT_NE(
+      md.find("| method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | max error m | latency p50 ms"),
+      std::string::npos);
   EXPECT_NE(md.find("| proposed | 0.050 | 0.100 | 0.000 | 0.112 | 5.00 | pass |"), std::string::npos) << md;
   EXPECT_NE(md.find("| icp | 0.500 | 2.500 |"), std::string::npos) << md;
   EXPECT_NE(md.find("FAIL"), std::string::npos);
@@ -313,7 +327,7 @@ TEST(ResultFiles, ComparisonTableAndCsv) {
 
 TEST(ResultFiles, ErrorsCsvHasOneLinePerScoredFrame) {
   const auto est = offset_estimates(2, 0.3, 0.2, 0);
-  const ScoredRun run = score(straight_truth(1), est, {}, "m", "s");
+  const ScoredRun run = score(straight_truth(1), est, straight_route(), {}, "m", "s");
   const std::string path = temp_path("errors.csv");
   write_errors_csv(path, run, est);
   std::ifstream in(path);
@@ -329,7 +343,7 @@ TEST(ResultFiles, ErrorsCsvHasOneLinePerScoredFrame) {
 
 TEST(ResultFiles, UnwritablePathThrowsNamingIt) {
   const std::string dir = kUnwritableDir;
-  const Metrics m = score(straight_truth(1), offset_estimates(1, 0, 0, 0), {}, "m", "s").metrics;
+  const Metrics m = score(straight_truth(1), offset_estimates(1, 0, 0, 0), straight_route(), {}, "m", "s").metrics;
   auto expect_names = [&](const std::function<void(const std::string&)>& write, const std::string& name) {
     const std::string path = dir + "/" + name;
     try {
@@ -364,7 +378,7 @@ TEST(ErrorPlots, WritePngsOfTheRequestedSize) {
     e.pose = {p.x + 0.02 * s, p.y + 0.3 * std::sin(s), p.yaw + 0.01 * std::cos(s)};
     est.push_back(e);
   }
-  const ScoredRun run = score(truth, est, {}, "m", "s");
+  const ScoredRun run = score(truth, est, straight_route(), {}, "m", "s");
   const Polyline2d curb = {{0, -5}, {100, -5}, {200, -5}};
 
   const std::string errors_png = temp_path("errors.png"), trajectory_png = temp_path("trajectory.png");
@@ -391,18 +405,109 @@ TEST(Score, SettlingFramesAreNotScoredAndLaneKeepingIsChecked) {
   est.front().pose.y += 5.0;  // the first fix, metres off
   PassThresholds t;
   t.max_position_error_m = 1.0;
-  EXPECT_FALSE(score(truth, est, t, "m", "s").metrics.pass);
+  EXPECT_FALSE(score(truth, est, straight_route(), t, "m", "s").metrics.pass);
   t.settle_s = 1e-9 * double(est[1].stamp_ns - est[0].stamp_ns) / 2;  // only the first frame settles
-  ScoredRun run = score(truth, est, t, "m", "s");
+  ScoredRun run = score(truth, est, straight_route(), t, "m", "s");
   EXPECT_TRUE(run.metrics.pass);
   EXPECT_EQ(run.metrics.settling_frames, 1u);
+  EXPECT_NEAR(run.metrics.max_lane_offset_m, 0, kEps);  // the truth drives on the route
+
+  // The truth 0.4 m, then 0.6 m, to the right of its lane's centre.
   t.max_lane_offset_m = 0.5;
-  run = score(truth, est, t, "m", "s");
-  score_lane_keeping(run.metrics, 0.4);
+  run = score(truth, est, straight_route(0.4), t, "m", "s");
   EXPECT_TRUE(run.metrics.pass);
-  score_lane_keeping(run.metrics, 0.6);
+  EXPECT_NEAR(run.metrics.max_lane_offset_m, 0.4, kEps);
+  run = score(truth, est, straight_route(0.6), t, "m", "s");
   EXPECT_FALSE(run.metrics.pass);
-  EXPECT_EQ(run.metrics.max_lane_offset_m, 0.6);
+  EXPECT_NEAR(run.metrics.max_lane_offset_m, 0.6, kEps);
+  ASSERT_EQ(run.metrics.failures.size(), 1u);
+  EXPECT_EQ(run.metrics.failures[0], "lane offset 0.600 m > 0.500 m");
+}
+
+// ---- Lane keeping on a circle: known truth, offset a constant distance from the route ----
+
+constexpr double kCircleRadius = 50;        // m
+constexpr double kCircleVertexStep = 0.25;  // degrees between the route's vertices
+// A point at constant distance from the circle is within R (1 - cos(step / 2)) = 0.12 mm of that
+// distance from the polyline through its vertices: the tolerance says the route was followed.
+constexpr double kLaneTolerance = 1e-3;   // m
+constexpr double kLaneSpeed = 10;         // m/s
+constexpr int64_t kTruthStep = 10 * kMs;  // 100 Hz
+
+// The circle about the origin, counter-clockwise, from (R, 0); `degrees` of it (360: closed).
+Path circle_route(double degrees) {
+  Polyline2d points;
+  for (double a = 0; a <= degrees + 1e-9; a += kCircleVertexStep)
+    points.push_back(kCircleRadius * Eigen::Vector2d(std::cos(a * kDeg), std::sin(a * kDeg)));
+  return make_path(points, degrees >= 360);
+}
+
+// Driving the circle counter-clockwise at kLaneSpeed from angle `start_rad` for `seconds`, `left` m to
+// the left of it (towards the centre), heading along it.
+std::vector<TruthPose> circle_truth(double start_rad, double seconds, double left) {
+  std::vector<TruthPose> truth;
+  for (int64_t t = 0; t < int64_t(seconds * double(kNsPerS)); t += kTruthStep) {
+    const double a = start_rad + kLaneSpeed * ns_to_s(t) / kCircleRadius;
+    const double r = kCircleRadius - left;
+    truth.push_back({t, {r * std::cos(a), r * std::sin(a), wrap_angle(a + kPi / 2)}});
+  }
+  return truth;
+}
+
+TEST(LaneOffsets, FollowTheCarRoundAClosedRouteLapAfterLap) {
+  constexpr int kLaps = 4;
+  constexpr double kLeft = 0.35;               // m, the truth's known offset from its lane's centre
+  constexpr double kStartRad = 0.3 * 2 * kPi;  // the first seam crossing comes mid-lap, as in a scenario
+  const Path route = circle_route(360);
+  ASSERT_TRUE(route.closed);
+  const double lap_s = 2 * kPi * kCircleRadius / kLaneSpeed;
+  const std::vector<TruthPose> truth = circle_truth(kStartRad, kLaps * lap_s, kLeft);
+
+  const std::vector<double> offsets = lane_offsets(truth, route);
+  ASSERT_EQ(offsets.size(), truth.size());
+  std::vector<double> worst_in_lap(kLaps, 0.0);  // the largest departure from kLeft, per lap
+  std::vector<size_t> samples_in_lap(kLaps, 0);
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const size_t lap = size_t(ns_to_s(truth[i].stamp_ns) / lap_s);
+    worst_in_lap.at(lap) = std::max(worst_in_lap[lap], std::abs(offsets[i] - kLeft));
+    ++samples_in_lap[lap];
+  }
+  for (int lap = 0; lap < kLaps; ++lap) {
+    EXPECT_GT(samples_in_lap[lap], 0u) << "lap " << lap + 1;
+    EXPECT_LT(worst_in_lap[lap], kLaneTolerance) << "lap " << lap + 1;
+  }
+
+  PassThresholds t;
+  t.max_lane_offset_m = 0.5;
+  const Metrics m = score(truth, {}, route, t, "m", "circle").metrics;
+  EXPECT_NEAR(m.max_lane_offset_m, kLeft, kLaneTolerance);
+  EXPECT_EQ(m.failures, std::vector<std::string>{"no estimates"});  // and nothing about the lane
+}
+
+TEST(LaneOffsets, AnOpenRouteEndsWhereItEnds) {
+  // Most of the circle, open: its end is 8.7 m from its start. Driven once to the right of it, then
+  // on past the end along its last segment: the projection stays at the end rather than wrapping to
+  // the start, and the distance is to the last segment's line.
+  constexpr double kArcDegrees = 350;
+  constexpr double kRight = 0.2;  // m
+  constexpr double kBeyondEnd_s = 1;
+  const Path route = circle_route(kArcDegrees);
+  ASSERT_FALSE(route.closed);
+  std::vector<TruthPose> truth = circle_truth(0, route.length / kLaneSpeed, -kRight);
+  const Pose2d end = route.pose_at(route.length);
+  const Eigen::Vector2d right_of_end =
+      Eigen::Vector2d(end.x, end.y) + kRight * Eigen::Vector2d(std::sin(end.yaw), -std::cos(end.yaw));
+  const int64_t t_end = truth.back().stamp_ns;
+  for (int64_t t = kTruthStep; t <= int64_t(kBeyondEnd_s * double(kNsPerS)); t += kTruthStep) {
+    const Eigen::Vector2d p =
+        right_of_end + kLaneSpeed * ns_to_s(t) * Eigen::Vector2d(std::cos(end.yaw), std::sin(end.yaw));
+    truth.push_back({t_end + t, {p.x(), p.y(), end.yaw}});
+  }
+
+  const std::vector<double> offsets = lane_offsets(truth, route);
+  ASSERT_EQ(offsets.size(), truth.size());
+  for (size_t i = 0; i < truth.size(); ++i) EXPECT_NEAR(offsets[i], -kRight, kLaneTolerance) << "sample " << i;
+  EXPECT_NEAR(score(truth, {}, route, {}, "m", "arc").metrics.max_lane_offset_m, kRight, kLaneTolerance);
 }
 
 }  // namespace
