@@ -15,15 +15,15 @@
 namespace lidarloop {
 namespace {
 
-constexpr double kSpacing = 0.1;      // m between map curb points (CurbLayer's default)
-constexpr double kWindow = 32.0;      // m, half size of the localizer's map window
-constexpr double kBlock = 40.0;       // m between street centre lines
-constexpr double kRoadWidth = 10.0;   // m between the curbs of a street
-constexpr double kGate = 1.0;         // m, the paper's d_g
-constexpr double kCurbNoise = 0.3;    // m: detected curbs around the true ones, as after a pose error
-constexpr double kOutliers = 0.2;     // fraction of detections that are not curbs at all
+constexpr double kSpacing = 0.1;     // m between map curb points (CurbLayer's default)
+constexpr double kWindow = 32.0;     // m, half size of the localizer's map window
+constexpr double kBlock = 40.0;      // m between street centre lines
+constexpr double kRoadWidth = 10.0;  // m between the curbs of a street
+constexpr double kGate = 1.0;        // m, the paper's d_g
+constexpr double kCurbNoise = 0.3;   // m: detected curbs around the true ones, as after a pose error
+constexpr double kOutliers = 0.2;    // fraction of detections that are not curbs at all
 constexpr size_t kQueries = 4096;
-constexpr size_t kScanCurbs = 110;    // curb features per scan on the campus drive
+constexpr size_t kScanCurbs = 110;  // curb features per scan on the campus drive
 
 // Streets every kBlock metres both ways; each has a curb either side of its centre line.
 std::vector<Eigen::Vector2d> city_blocks() {

@@ -25,10 +25,10 @@ void write_curb_map(const std::string& path, const CurbMap& map) {
                         {"geometry", {{"type", "LineString"}, {"coordinates", coordinates}}}});
   }
   // The origin travels with the map as a foreign member, so a reader recovers the same local frame.
-  const json doc = {{"type", "FeatureCollection"},
-                    {"lidarloop", {{"world", map.world},
-                                   {"origin", {map.origin.lon_deg, map.origin.lat_deg, map.origin.alt_m}}}},
-                    {"features", features}};
+  const json doc = {
+      {"type", "FeatureCollection"},
+      {"lidarloop", {{"world", map.world}, {"origin", {map.origin.lon_deg, map.origin.lat_deg, map.origin.alt_m}}}},
+      {"features", features}};
   std::ofstream out(path);
   if (!out) throw InputError(path + ": cannot write file");
   out << doc.dump(1) << '\n';

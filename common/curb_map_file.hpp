@@ -13,9 +13,9 @@ namespace lidarloop {
 using Polyline2d = std::vector<Eigen::Vector2d>;
 
 struct CurbMap {
-  Geodetic origin;                 // the local frame's origin
-  std::string world;               // name of the world it was made from (may be empty)
-  std::vector<Polyline2d> curbs;   // local metres
+  Geodetic origin;                // the local frame's origin
+  std::string world;              // name of the world it was made from (may be empty)
+  std::vector<Polyline2d> curbs;  // local metres
 };
 
 void write_curb_map(const std::string& path, const CurbMap& map);

@@ -5,8 +5,7 @@
 namespace lidarloop {
 
 LocalFrame::LocalFrame(const Geodetic& origin)
-    : origin_(origin),
-      projection_(GeographicLib::Constants::WGS84_a(), GeographicLib::Constants::WGS84_f(), 1.0) {
+    : origin_(origin), projection_(GeographicLib::Constants::WGS84_a(), GeographicLib::Constants::WGS84_f(), 1.0) {
   double easting = 0;
   projection_.Forward(origin.lon_deg, origin.lat_deg, origin.lon_deg, easting, origin_northing_);
 }

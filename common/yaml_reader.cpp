@@ -25,8 +25,8 @@ YamlReader YamlReader::from_string(const std::string& text, std::string name) {
   try {
     return YamlReader(name, text, YAML::Load(text));
   } catch (const YAML::Exception& e) {
-    throw InputError(name + ":" + std::to_string(e.mark.line + 1) + ":" +
-                     std::to_string(e.mark.column + 1) + ": YAML syntax error: " + e.msg);
+    throw InputError(name + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                     ": YAML syntax error: " + e.msg);
   }
 }
 
@@ -89,8 +89,8 @@ long YamlReader::integer_in(const YAML::Node& node, std::string_view what, long 
   if (!node.IsScalar() || !YAML::convert<long>::decode(node, value))
     fail(node, std::string(what) + " must be an integer");
   if (value < lo || value > hi)
-    fail(node, std::string(what) + " = " + std::to_string(value) + " is out of range [" +
-                   std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    fail(node, std::string(what) + " = " + std::to_string(value) + " is out of range [" + std::to_string(lo) + ", " +
+                   std::to_string(hi) + "]");
   return value;
 }
 

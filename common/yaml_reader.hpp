@@ -4,8 +4,8 @@
 #include <string>
 #include <string_view>
 
-#include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Core>
 
 #include "common/input_error.hpp"
 

@@ -11,11 +11,11 @@ namespace {
 
 constexpr int kMaxRings = 64;
 constexpr double kMinGap = 0.15, kGapSteps = 4, kAzimuthStep = 0.0029;  // m, -, rad
-constexpr double kMinRange = 1.0;      // m: about the sensor's own minimum range
-constexpr size_t kMinRingPoints = 5;   // fewer cannot hold a road, a rise and a sidewalk
-constexpr int kNoSegment = -1;         // the segment of the sentinel past a ring's last point
-constexpr long kLookahead = 3;         // points a walk along a ring tests at once (see first_ahead)
-constexpr long kWalks = 4;             // walks along a ring run side by side (see walk_ahead)
+constexpr double kMinRange = 1.0;                                       // m: about the sensor's own minimum range
+constexpr size_t kMinRingPoints = 5;  // fewer cannot hold a road, a rise and a sidewalk
+constexpr int kNoSegment = -1;        // the segment of the sentinel past a ring's last point
+constexpr long kLookahead = 3;        // points a walk along a ring tests at once (see first_ahead)
+constexpr long kWalks = 4;            // walks along a ring run side by side (see walk_ahead)
 // The cheap test on means lets through anything within this factor of the limits; the exact test on
 // medians then decides. Means move with a stray return, so the margin is generous.
 constexpr double kPrefilterSlack = 2.0;
@@ -101,9 +101,7 @@ struct Ring {
     return (z_sum[b + 1] - z_sum[a]) / double(b - a + 1);
   }
   // k (a point, the end sentinel or -1) if it lies in point i's segment, else -1.
-  long if_same_segment(long k, long i) const {
-    return k >= 0 && segment[size_t(k)] == segment[size_t(i)] ? k : -1;
-  }
+  long if_same_segment(long k, long i) const { return k >= 0 && segment[size_t(k)] == segment[size_t(i)] ? k : -1; }
 };
 
 // From k (at most the end sentinel), the first index whose arc length is `length` or more past s_i.

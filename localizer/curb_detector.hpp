@@ -12,13 +12,13 @@
 namespace lidarloop {
 
 struct CurbDetectorParams {
-  double min_height = 0.05;        // m: lower steps are road texture or noise
-  double max_height = 0.30;        // m: higher steps are walls, cars, people
-  double step_length = 0.40;       // m along the ring over which the rise must happen
-  double flat_length = 0.50;       // m of ring on each side that must be flat
+  double min_height = 0.05;          // m: lower steps are road texture or noise
+  double max_height = 0.30;          // m: higher steps are walls, cars, people
+  double step_length = 0.40;         // m along the ring over which the rise must happen
+  double flat_length = 0.50;         // m of ring on each side that must be flat
   double max_flat_roughness = 0.02;  // m: RMS height spread allowed on a flat stretch
-  double max_range = 25.0;         // m: beyond, ring spacing is too coarse to see a curb
-  double max_ground_height = 0.5;  // m above the vehicle's ground plane (z = 0 in the vehicle frame)
+  double max_range = 25.0;           // m: beyond, ring spacing is too coarse to see a curb
+  double max_ground_height = 0.5;    // m above the vehicle's ground plane (z = 0 in the vehicle frame)
 };
 
 // `points`: the scan in the vehicle frame (x forward, y left, z up from the ground), in firing order.

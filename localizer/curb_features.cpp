@@ -41,7 +41,10 @@ struct Cloud2d {  // nanoflann dataset interface
   const std::vector<Eigen::Vector2d>& points;
   size_t kdtree_get_point_count() const { return points.size(); }
   double kdtree_get_pt(size_t i, size_t dim) const { return points[i][int(dim)]; }
-  template <class BBox> bool kdtree_get_bbox(BBox&) const { return false; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
 };
 }  // namespace
 
@@ -71,7 +74,7 @@ std::vector<Eigen::Vector2d> beam_model(const std::vector<Eigen::Vector2d>& curb
     for (size_t i = 0; i < curbs.size(); ++i) {
       const Eigen::Vector2d v = curbs[i] - origin;
       if (std::abs(v.x()) > p.beam_half_extent || std::abs(v.y()) > p.beam_half_extent) continue;  // Eq. 6 box
-      const double angle = std::atan2(v.y(), v.x()) + M_PI;  // [0, 2 pi]
+      const double angle = std::atan2(v.y(), v.x()) + M_PI;                                        // [0, 2 pi]
       const size_t k = std::min(size_t(angle / bin), size_t(p.beams) - 1);
       const double r = v.norm();
       if (r < nearest[k].first) nearest[k] = {r, i};  // Eq. 7: the shortest distance in the beam

@@ -12,7 +12,10 @@ struct PointsAdaptor {
   const std::vector<Eigen::Vector2d>* points;
   size_t kdtree_get_point_count() const { return points->size(); }
   double kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][int(dim)]; }
-  template <class BBox> bool kdtree_get_bbox(BBox&) const { return false; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
 };
 
 struct CurbLayer::Index {

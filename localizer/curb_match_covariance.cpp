@@ -32,8 +32,9 @@ CurbMatchQuality curb_match_quality(const std::vector<Eigen::Vector2d>& curbs_ve
   const double weak = 1.0 / (noise.unconstrained_sigma_m * noise.unconstrained_sigma_m);
   information.diagonal().array() += weak;
   q.covariance = information.inverse();
-  q.covariance.diagonal() += Eigen::Vector3d(noise.min_sigma_m * noise.min_sigma_m, noise.min_sigma_m * noise.min_sigma_m,
-                                             noise.min_sigma_yaw_rad * noise.min_sigma_yaw_rad);
+  q.covariance.diagonal() +=
+      Eigen::Vector3d(noise.min_sigma_m * noise.min_sigma_m, noise.min_sigma_m * noise.min_sigma_m,
+                      noise.min_sigma_yaw_rad * noise.min_sigma_yaw_rad);
   return q;
 }
 

@@ -30,7 +30,8 @@ static void append(ScanPoints& s, const Eigen::Vector3d& xyz, const LidarPoint& 
   s.intensity.push_back(p.intensity);
 }
 
-ScanPoints deskew(const PointCloud& cloud, const Eigen::Isometry3d& mount, const ScanMotion& motion, int64_t reference_ns) {
+ScanPoints deskew(const PointCloud& cloud, const Eigen::Isometry3d& mount, const ScanMotion& motion,
+                  int64_t reference_ns) {
   const Eigen::Isometry3d reference_inverse = arc_pose(motion, double(reference_ns) * 1e-9).inverse();
   ScanPoints out;
   reserve(out, cloud.points.size());

@@ -77,7 +77,8 @@ DrivingCorridor extract_driving_corridor(const std::vector<Eigen::Vector2d>& cur
       const std::uint8_t* row = free_space.ptr<std::uint8_t>(r);
       for (int c = 0; c < free_space.cols; ++c) {
         if (row[c] == 0) continue;
-        const long d2 = static_cast<long>(r - centre.y) * (r - centre.y) + static_cast<long>(c - centre.x) * (c - centre.x);
+        const long d2 =
+            static_cast<long>(r - centre.y) * (r - centre.y) + static_cast<long>(c - centre.x) * (c - centre.x);
         if (d2 < best) best = d2, seed = {c, r};
       }
     }

@@ -28,7 +28,7 @@ struct CorridorParams {
 };
 
 struct DrivingCorridor {
-  Pose2d pose;            // the vehicle pose (local frame) the grid was built around
+  Pose2d pose;  // the vehicle pose (local frame) the grid was built around
   CorridorParams params;
   // CV_8U, 255 = corridor, 0 = curb, sidewalk or anything not connected to the vehicle. Laid out as
   // a bird's-eye image of the vehicle frame: column = forward (x grows to the right), row = left

@@ -54,8 +54,8 @@ int rasterise(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d&
   for (const auto& p : points) {
     if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
     const Eigen::Vector2d d = p - centre;
-    const Eigen::Vector2d q = to_pixel(centre + Eigen::Vector2d(c * d.x() - s * d.y(), s * d.x() + c * d.y()),
-                                       centre, params);
+    const Eigen::Vector2d q =
+        to_pixel(centre + Eigen::Vector2d(c * d.x() - s * d.y(), s * d.x() + c * d.y()), centre, params);
     // All four bilinear neighbours must be on the grid; a point on the outermost half cell is dropped.
     if (!(q.x() >= 0 && q.y() >= 0 && q.x() < n - 1 && q.y() < n - 1)) continue;
     const int col = static_cast<int>(q.x()), row = static_cast<int>(q.y());

@@ -42,9 +42,9 @@ constexpr double kTileSizeRelativeTolerance = 1e-9;
 // Tile files: little-endian; header, cells, CRC-32 of everything before it.
 constexpr std::array<char, 4> kTileMagic = {'L', 'L', 'I', 'T'};
 constexpr uint32_t kTileVersion = 1;
-constexpr size_t kWordBytes = 4;                        // every field is a 32-bit word
-constexpr size_t kTileHeaderBytes = 5 * kWordBytes;     // magic, version, tile_x, tile_y, tile_cells
-constexpr size_t kCellBytes = 3 * kWordBytes;           // count, mean, m2
+constexpr size_t kWordBytes = 4;                     // every field is a 32-bit word
+constexpr size_t kTileHeaderBytes = 5 * kWordBytes;  // magic, version, tile_x, tile_y, tile_cells
+constexpr size_t kCellBytes = 3 * kWordBytes;        // count, mean, m2
 constexpr size_t kCrcBytes = kWordBytes;
 constexpr const char* kTileExtension = ".tile";
 constexpr const char* kTempSuffix = ".tmp";
@@ -58,11 +58,15 @@ void put_u32(std::string& out, uint32_t v) { append_le(out, v, sizeof v); }
 void put_i32(std::string& out, int32_t v) { put_u32(out, static_cast<uint32_t>(v)); }
 void put_f32(std::string& out, float v) { put_u32(out, std::bit_cast<uint32_t>(v)); }
 
-uint32_t get_u32(const std::string& in, size_t offset) { return uint32_t(get_le(in.data() + offset, sizeof(uint32_t))); }
+uint32_t get_u32(const std::string& in, size_t offset) {
+  return uint32_t(get_le(in.data() + offset, sizeof(uint32_t)));
+}
 int32_t get_i32(const std::string& in, size_t offset) { return static_cast<int32_t>(get_u32(in, offset)); }
 float get_f32(const std::string& in, size_t offset) { return std::bit_cast<float>(get_u32(in, offset)); }
 
-size_t tile_file_bytes(size_t tile_cells) { return kTileHeaderBytes + tile_cells * tile_cells * kCellBytes + kCrcBytes; }
+size_t tile_file_bytes(size_t tile_cells) {
+  return kTileHeaderBytes + tile_cells * tile_cells * kCellBytes + kCrcBytes;
+}
 
 // Built by appending: GCC 12 warns falsely (-Wrestrict, bug 105651) on some `"literal" + string` chains.
 std::string tile_file_name(int tx, int ty) {
@@ -99,7 +103,8 @@ std::optional<int64_t> global_cell(double coord, double resolution, int tile_cel
   double q = coord / resolution;
   if (!std::isfinite(q)) return std::nullopt;
   const double nearest = std::round(q);
-  if (std::fabs(q - nearest) <= kBoundarySnapUlps * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(q)))
+  if (std::fabs(q - nearest) <=
+      kBoundarySnapUlps * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(q)))
     q = nearest;
   const double cell = std::floor(q);
   // Both bounds are exact in double (|value| < 2^44 for tile_cells <= 4096).
@@ -121,7 +126,9 @@ std::optional<CellIndex> try_cell_index(const IntensityMapHeader& h, const Eigen
                    static_cast<int>(*gy - ty * n)};
 }
 
-size_t flat_index(const CellIndex& c, int tile_cells) { return size_t(c.cell_y) * size_t(tile_cells) + size_t(c.cell_x); }
+size_t flat_index(const CellIndex& c, int tile_cells) {
+  return size_t(c.cell_y) * size_t(tile_cells) + size_t(c.cell_x);
+}
 
 std::vector<IntensityMoments>& tile_or_new(std::map<std::pair<int, int>, std::vector<IntensityMoments>>& tiles,
                                            IntensityMapHeader& header, std::pair<int, int> key) {
@@ -184,8 +191,7 @@ std::string header_yaml(const IntensityMapHeader& h) {
   out << YAML::Key << "tile_cells" << YAML::Value << h.tile_cells;
   out << YAML::Key << "tile_size_m" << YAML::Value << shortest(h.tile_size_m());
   out << YAML::Key << "build" << YAML::Value << YAML::BeginMap;
-  for (const auto& [key, value] : h.build)
-    out << YAML::Key << key << YAML::Value << value;
+  for (const auto& [key, value] : h.build) out << YAML::Key << key << YAML::Value << value;
   out << YAML::EndMap;
   out << YAML::Key << "tiles" << YAML::Value << YAML::BeginSeq;
   for (const auto& [tx, ty] : h.tiles) out << YAML::Flow << YAML::BeginSeq << tx << ty << YAML::EndSeq;
@@ -240,8 +246,8 @@ std::vector<IntensityCell> load_tile(const fs::path& path, const IntensityMapHea
   const uint32_t computed_crc = crc32(bytes.data(), expected - kCrcBytes);
   if (stored_crc != computed_crc) {
     std::ostringstream msg;
-    msg << file << ": checksum mismatch (CRC-32 stored 0x" << std::hex << stored_crc << ", computed 0x"
-        << computed_crc << "): the tile file is corrupt";
+    msg << file << ": checksum mismatch (CRC-32 stored 0x" << std::hex << stored_crc << ", computed 0x" << computed_crc
+        << "): the tile file is corrupt";
     throw InputError(msg.str());
   }
   if (file_tx != tx || file_ty != ty)
@@ -393,7 +399,8 @@ IntensityMapHeader read_intensity_map_header(const std::string& dir) {
   const YAML::Node version = yaml.required(root, "version");
   const long v = yaml.integer_in(version, "version", LONG_MIN, LONG_MAX);
   if (v != kFormatVersion)
-    yaml.fail(version, "unsupported version " + std::to_string(v) + " (expected " + std::to_string(kFormatVersion) + ")");
+    yaml.fail(version,
+              "unsupported version " + std::to_string(v) + " (expected " + std::to_string(kFormatVersion) + ")");
 
   h.world = yaml.string(yaml.required(root, "world"), "world");
   h.world_hash = yaml.string(yaml.required(root, "world_hash"), "world_hash");
@@ -416,12 +423,13 @@ IntensityMapHeader read_intensity_map_header(const std::string& dir) {
   const YAML::Node tile_size = yaml.required(root, "tile_size_m");
   const double size = yaml.number(tile_size, "tile_size_m");
   if (std::fabs(size - h.tile_size_m()) > kTileSizeRelativeTolerance * h.tile_size_m())
-    yaml.fail(tile_size, "tile_size_m = " + tile_size.Scalar() + " does not match resolution_m * tile_cells = " +
-                             shortest(h.tile_size_m()));
+    yaml.fail(tile_size, "tile_size_m = " + tile_size.Scalar() +
+                             " does not match resolution_m * tile_cells = " + shortest(h.tile_size_m()));
 
   const YAML::Node build = yaml.required(root, "build");
   yaml.expect_map(build, "build");
-  for (const auto& entry : build) h.build[yaml.string(entry.first, "build key")] = yaml.string(entry.second, "build value");
+  for (const auto& entry : build)
+    h.build[yaml.string(entry.first, "build key")] = yaml.string(entry.second, "build value");
 
   const YAML::Node tiles = yaml.required(root, "tiles");
   yaml.expect_sequence(tiles, "tiles");

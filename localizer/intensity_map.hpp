@@ -26,8 +26,8 @@ struct IntensityCell {
   float mean = 0;
   float m2 = 0;  // sum of squared deviations from the mean (Welford); variance = m2 / count
 
-  void add(double value);                       // Eq. 8
-  void merge(const IntensityCell& other);       // Chan et al.'s pairwise combination
+  void add(double value);                  // Eq. 8
+  void merge(const IntensityCell& other);  // Chan et al.'s pairwise combination
   double variance() const { return count > 0 ? double(m2) / double(count) : 0.0; }
 };
 
@@ -39,19 +39,19 @@ struct IntensityMoments {
   double mean = 0;
   double m2 = 0;
 
-  void add(double value);                       // Eq. 8 (Welford form)
-  void merge(const IntensityMoments& other);    // Chan et al.
+  void add(double value);                     // Eq. 8 (Welford form)
+  void merge(const IntensityMoments& other);  // Chan et al.
   double variance() const { return count > 0 ? m2 / double(count) : 0.0; }
   IntensityCell to_cell() const { return {count, float(mean), float(m2)}; }
   static IntensityMoments from_cell(const IntensityCell& c) { return {c.count, c.mean, c.m2}; }
 };
 
 struct IntensityMapHeader {
-  std::string world;               // world name
-  std::string world_hash;          // hex digest of what the map was built from
-  Geodetic origin;                 // of the local frame (transverse Mercator, scale 1 on its meridian)
-  double resolution_m = 0.2;       // cell size
-  int tile_cells = 320;            // cells per tile side (64 m at 0.2 m)
+  std::string world;                         // world name
+  std::string world_hash;                    // hex digest of what the map was built from
+  Geodetic origin;                           // of the local frame (transverse Mercator, scale 1 on its meridian)
+  double resolution_m = 0.2;                 // cell size
+  int tile_cells = 320;                      // cells per tile side (64 m at 0.2 m)
   std::map<std::string, std::string> build;  // free-form build parameters, for people and cache keys
   std::vector<std::pair<int, int>> tiles;    // tile indices present on disk
 

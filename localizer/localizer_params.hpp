@@ -28,10 +28,10 @@ bool removes_obstacles(LocalizerMethod m);
 
 // When the localizer calls its inputs unhealthy, and what it refuses to use.
 struct HealthParams {
-  double gps_timeout_s = 1.0;  // no fix for this long: "no GPS"
-  double can_timeout_s = 0.1;  // no CAN frame for this long: "CAN gap" (the bus runs at 100 Hz)
-  int min_scan_points = 1000;  // fewer valid points: treated as an empty scan
-  int min_curbs = 15;          // fewer curb features (n_p): no curb observation
+  double gps_timeout_s = 1.0;     // no fix for this long: "no GPS"
+  double can_timeout_s = 0.1;     // no CAN frame for this long: "CAN gap" (the bus runs at 100 Hz)
+  int min_scan_points = 1000;     // fewer valid points: treated as an empty scan
+  int min_curbs = 15;             // fewer curb features (n_p): no curb observation
   double min_inlier_ratio = 0.5;  // a match explaining fewer of the features is not used
   // Innovation gate of the map-matching observations: chi^2 with 3 (curbs) or 2 (intensity) degrees of
   // freedom at 99.9 %. Past `max_rejections` in a row the filter doubles its position variance with
@@ -43,7 +43,7 @@ struct HealthParams {
 };
 
 struct GpsNoise {
-  double min_sigma_m = 0.5;          // floor on the receiver's reported position sigma
+  double min_sigma_m = 0.5;  // floor on the receiver's reported position sigma
   double min_heading_sigma_rad = 0.02;
   // Scales the receiver's variances. A low-cost receiver's error is mostly a slowly wandering bias
   // (Gauss-Markov, tau of minutes), so fixes 0.1 s apart are far from independent, and a filter that
@@ -60,8 +60,8 @@ struct LocalizerParams {
   // The LiDAR's pose in the vehicle frame (the extrinsic calibration). Not in YAML: it comes with the
   // sensor data (scenario's lidar section, a log's transforms).
   Eigen::Isometry3d lidar_mount = Eigen::Isometry3d::Identity();
-  uint64_t seed = 1;               // probabilistic ICP's draws
-  double map_window_m = 32;        // curbs of the map within this half size are matched against
+  uint64_t seed = 1;                    // probabilistic ICP's draws
+  double map_window_m = 32;             // curbs of the map within this half size are matched against
   double max_prediction_step_s = 0.01;  // Eq. 19 is integrated in steps no longer than this
 
   CorridorParams corridor;
@@ -69,7 +69,7 @@ struct LocalizerParams {
   CurbDetectorParams curb_detector;
   CurbFeatureParams curb_features;
   ProbabilisticIcpParams probabilistic_icp;
-  IcpParams icp;   // the icp and icp-obs baselines
+  IcpParams icp;  // the icp and icp-obs baselines
   MIcpParams m_icp;
   FmtParams fmt;
   IntensityGridParams intensity_grid;

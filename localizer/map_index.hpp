@@ -44,9 +44,9 @@ class MapIndex {
     Eigen::Vector2d origin = Eigen::Vector2d::Zero();
     double size = kDefaultBucketM;
     int cols = 0, rows = 0;
-    std::vector<uint32_t> start;            // bucket k holds sorted[start[k] .. start[k + 1])
-    std::vector<Eigen::Vector2d> sorted;    // the points in bucket order
-    std::vector<uint32_t> index;            // sorted[i] is points_[index[i]]
+    std::vector<uint32_t> start;          // bucket k holds sorted[start[k] .. start[k + 1])
+    std::vector<Eigen::Vector2d> sorted;  // the points in bucket order
+    std::vector<uint32_t> index;          // sorted[i] is points_[index[i]]
   };
   std::vector<Eigen::Vector2d> points_;
   std::unique_ptr<Tree> tree_;

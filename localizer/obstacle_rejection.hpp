@@ -51,12 +51,12 @@ struct ObstacleSplit {
 
 // corridor_points: vehicle frame (z up), already inside the driving corridor. Non-finite points are
 // dropped first (in neither output). The plane: Eq. 2 on the lowest xi % of the cells' lowest points,
-// refitted on all points near it (see ObstacleParams). Obstacle = more than d_sigma from the plane (Eq. 3) AND above it.
-// Eq. 3 uses |d|, but a point far below the road cannot be something the car drives into or something
-// that hides a curb: it is a reflection (wet road, glass; the mirrored return lands under the ground),
-// a dip beyond the fitted patch, or a ditch. Calling it an obstacle would only remove ground evidence.
-// Without a plane (fewer than 3 points, degenerate) nothing is rejected: every point is ground, which
-// degrades to plain ICP rather than to throwing the scan away.
+// refitted on all points near it (see ObstacleParams). Obstacle = more than d_sigma from the plane (Eq. 3) AND above
+// it. Eq. 3 uses |d|, but a point far below the road cannot be something the car drives into or something that hides a
+// curb: it is a reflection (wet road, glass; the mirrored return lands under the ground), a dip beyond the fitted
+// patch, or a ditch. Calling it an obstacle would only remove ground evidence. Without a plane (fewer than 3 points,
+// degenerate) nothing is rejected: every point is ground, which degrades to plain ICP rather than to throwing the scan
+// away.
 ObstacleSplit reject_obstacles(const std::vector<Eigen::Vector3d>& corridor_points, const ObstacleParams& params = {});
 
 }  // namespace lidarloop

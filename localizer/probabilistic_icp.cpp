@@ -14,7 +14,7 @@ namespace lidarloop {
 // The SVD step
 
 Pose2d fit_rigid_2d(const std::vector<Eigen::Vector2d>& src, const std::vector<Eigen::Vector2d>& dst,
-                         const std::vector<double>* weights) {
+                    const std::vector<double>* weights) {
   if (src.size() != dst.size() || (weights && weights->size() != src.size()))
     throw std::invalid_argument("fit_rigid_2d: src, dst and weights must have the same size");
   double total = 0;
@@ -119,8 +119,8 @@ size_t draw_below(std::mt19937_64& rng, size_t n) {
 
 }  // namespace
 
-IcpResult icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial,
-              const IcpParams& params, double reject_distance) {
+IcpResult icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial, const IcpParams& params,
+              double reject_distance) {
   // Eq. 12: a curb farther than reject_distance from the map is an outlier and takes no part in the fit.
   const double gate = std::min(params.max_correspondence, reject_distance);
   return run_icp(map, curbs, initial, params, gate, [](double) { return 1.0; });
@@ -161,8 +161,8 @@ Pose2d fuse_hypotheses(const std::vector<IcpHypothesis>& hypotheses, double outl
   return {x / total, y / total, std::atan2(s, c)};
 }
 
-IcpResult probabilistic_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs,
-                            Pose2d initial, const ProbabilisticIcpParams& params, std::mt19937_64& rng) {
+IcpResult probabilistic_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial,
+                            const ProbabilisticIcpParams& params, std::mt19937_64& rng) {
   IcpResult result;
   result.t = initial;
   if (curbs.empty() || map.empty()) return result;
@@ -199,7 +199,8 @@ IcpResult probabilistic_icp(const MapIndex& map, const std::vector<Eigen::Vector
   result.t = fuse_hypotheses(hypotheses, params.outlier_softness_curbs / double(n));  // Eq. 13
   result.iterations = n_t;
   const double d_g = params.d_g;
-  score(map, curbs, std::min(d_g, params.global.max_correspondence), [](double) { return 1.0; }, result);
+  score(
+      map, curbs, std::min(d_g, params.global.max_correspondence), [](double) { return 1.0; }, result);
   return result;
 }
 

@@ -25,12 +25,12 @@ namespace lidarloop {
 // and cannot produce a reflection. Null weights = all 1. Fewer than one usable pair -> identity; one
 // pair -> pure translation.
 Pose2d fit_rigid_2d(const std::vector<Eigen::Vector2d>& src, const std::vector<Eigen::Vector2d>& dst,
-                         const std::vector<double>* weights = nullptr);
+                    const std::vector<double>* weights = nullptr);
 
 struct IcpParams {
   int max_iterations = 30;
-  double convergence = 1e-4;         // stop when an update moves less than this (m and rad)
-  double max_correspondence = 2.0;   // m; nearest neighbours farther than this are never paired
+  double convergence = 1e-4;        // stop when an update moves less than this (m and rad)
+  double max_correspondence = 2.0;  // m; nearest neighbours farther than this are never paired
 };
 
 struct IcpResult {
@@ -45,8 +45,8 @@ struct IcpResult {
 // Correspondences farther than min(max_correspondence, reject_distance) are dropped each iteration
 // (with reject_distance = d_g this is Eq. 12); the same distance defines outliers in the result.
 // Empty curbs or map: returns `initial` with outlier_ratio 1.
-IcpResult icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial,
-              const IcpParams& params, double reject_distance = std::numeric_limits<double>::infinity());
+IcpResult icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial, const IcpParams& params,
+              double reject_distance = std::numeric_limits<double>::infinity());
 
 struct MIcpParams {
   IcpParams icp;
@@ -99,7 +99,7 @@ Pose2d fuse_hypotheses(const std::vector<IcpHypothesis>& hypotheses, double outl
 // Fewer than n_p curbs: every draw is all curbs, so one draw is made. Empty curbs or map: `initial`
 // with outlier_ratio 1. The result's outlier_ratio, inliers and rmse are those of the fused transform
 // against d_g.
-IcpResult probabilistic_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs,
-                            Pose2d initial, const ProbabilisticIcpParams& params, std::mt19937_64& rng);
+IcpResult probabilistic_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, Pose2d initial,
+                            const ProbabilisticIcpParams& params, std::mt19937_64& rng);
 
 }  // namespace lidarloop

@@ -12,9 +12,7 @@ constexpr size_t kHeader = 4;  // encapsulation kind (2 bytes, big endian) + opt
 
 CdrWriter::CdrWriter() : buf_{0x00, 0x01, 0x00, 0x00} {}
 
-CdrWriter::CdrWriter(std::vector<uint8_t>&& reuse) : buf_(std::move(reuse)) {
-  buf_.assign({0x00, 0x01, 0x00, 0x00});
-}
+CdrWriter::CdrWriter(std::vector<uint8_t>&& reuse) : buf_(std::move(reuse)) { buf_.assign({0x00, 0x01, 0x00, 0x00}); }
 
 void CdrWriter::align(size_t n) {
   while ((buf_.size() - kHeader) % n != 0) buf_.push_back(0);

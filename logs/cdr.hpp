@@ -27,8 +27,8 @@ class CdrWriter {
   void f32(float v);
   void f64(double v);
   void string(std::string_view s);
-  void sequence_length(size_t n);                // a sequence's element count
-  void raw(std::span<const uint8_t> bytes);      // uint8 elements: no alignment, no count
+  void sequence_length(size_t n);            // a sequence's element count
+  void raw(std::span<const uint8_t> bytes);  // uint8 elements: no alignment, no count
 
   size_t size() const { return buf_.size(); }
   std::vector<uint8_t>& buffer() { return buf_; }

@@ -185,8 +185,8 @@ ExportResult export_kitti(const std::string& log, const std::string& dir, const 
       const auto h = ros2::decode_gnss_heading(m.data, context(reader, m));
       // The heading follows its fix on the same receiver's topic: /gps/fix -> /gps/heading.
       const std::string fix_topic = t.substr(0, t.rfind('/')) + "/fix";
-      if (auto it = fixes.find(fix_topic); it != fixes.end() && !it->second.empty() &&
-                                           it->second.back().fix.stamp_ns == h.stamp_ns)
+      if (auto it = fixes.find(fix_topic);
+          it != fixes.end() && !it->second.empty() && it->second.back().fix.stamp_ns == h.stamp_ns)
         it->second.back().heading = h.heading;
     } else if (t == log_topics::truth_state && has_type(m, "lidarloop_msgs/msg/TruthState")) {
       truth = ros2::decode_truth_state(m.data, context(reader, m));
@@ -207,10 +207,9 @@ ExportResult export_kitti(const std::string& log, const std::string& dir, const 
     out.precision(12);
     // lat lon alt roll pitch yaw vn ve vf vl vu ax ay az af al au wx wy wz wf wl wu
     // pos_accuracy vel_accuracy navstat numsats posmode velmode orimode
-    out << f.fix.lat_deg << ' ' << f.fix.lon_deg << ' ' << f.fix.alt_m << " 0 0 " << f.heading << ' ' << vn << ' '
-        << ve << ' ' << vf << " 0 0 0 0 0 0 0 0 0 0 " << f.yaw_rate << " 0 0 " << f.yaw_rate << ' ' << accuracy
-        << " 0 " << (f.fix.status == GpsStatus::no_fix ? 0 : 4) << " 0 " << (f.fix.status == GpsStatus::rtk ? 5 : 2)
-        << " 0 0\n";
+    out << f.fix.lat_deg << ' ' << f.fix.lon_deg << ' ' << f.fix.alt_m << " 0 0 " << f.heading << ' ' << vn << ' ' << ve
+        << ' ' << vf << " 0 0 0 0 0 0 0 0 0 0 " << f.yaw_rate << " 0 0 " << f.yaw_rate << ' ' << accuracy << " 0 "
+        << (f.fix.status == GpsStatus::no_fix ? 0 : 4) << " 0 " << (f.fix.status == GpsStatus::rtk ? 5 : 2) << " 0 0\n";
     oxts_stamps << kitti_timestamp(f.fix.stamp_ns) << "\n";
   }
   std::ofstream format = open_out(oxts + "/dataformat.txt");
@@ -224,7 +223,8 @@ ExportResult export_kitti(const std::string& log, const std::string& dir, const 
             "pos_accuracy: position accuracy (m), from the fix covariance\nvel_accuracy: 0\n"
             "navstat: 4 with a fix, 0 without\nnumsats: 0 (not simulated)\n"
             "posmode: 5 RTK, 2 single-point\nvelmode, orimode: 0\n"
-            "source: " << gnss << "\n";
+            "source: "
+         << gnss << "\n";
 
   if (mount) {
     // KITTI's calib_imu_to_velo maps IMU coordinates into the LiDAR frame: the inverse of the mount.

@@ -36,8 +36,8 @@ uint16_t McapRecorder::channel(const ChannelSpec& spec) {
   auto schema = schemas_.find(spec.type);
   if (schema == schemas_.end())
     schema = schemas_.emplace(spec.type, writer_.add_schema(spec.type, "ros2msg", ros2::schema_text(spec.type))).first;
-  const uint16_t id = writer_.add_channel(schema->second, spec.topic, "cdr",
-                                          {{"offered_qos_profiles", qos_profile(spec.latched)}});
+  const uint16_t id =
+      writer_.add_channel(schema->second, spec.topic, "cdr", {{"offered_qos_profiles", qos_profile(spec.latched)}});
   channels_.emplace(spec.topic, id);
   return id;
 }
@@ -60,8 +60,8 @@ void McapRecorder::write_truth(const TruthSample& truth) {
   odom.linear.x() = truth.speed;
   odom.angular.z() = truth.yaw_rate;
   write(odometry, truth.stamp_ns, ros2::encode_odometry(odom));
-  write(tf, truth.stamp_ns, ros2::encode_tf({ros2::planar_transform(truth.stamp_ns, t::map_frame, t::vehicle_frame,
-                                                                    truth.pose)}));
+  write(tf, truth.stamp_ns,
+        ros2::encode_tf({ros2::planar_transform(truth.stamp_ns, t::map_frame, t::vehicle_frame, truth.pose)}));
 }
 
 void McapRecorder::write_can(const CanFrame& frame) {
@@ -109,7 +109,8 @@ void McapRecorder::add_attachment(const std::string& name, const std::string& me
 }
 
 void McapRecorder::add_attachment(const std::string& name, const std::string& media_type, std::string_view bytes) {
-  add_attachment(name, media_type, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
+  add_attachment(name, media_type,
+                 std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
 }
 
 void McapRecorder::add_metadata(const std::string& name, const std::map<std::string, std::string>& values) {

@@ -58,8 +58,8 @@ class McapRecorder {
 
   McapWriter writer_;
   std::map<std::string, uint16_t> schemas_, channels_;  // by type, by topic
-  uint64_t clock_ = 0;  // log time: the newest stamp received
-  std::vector<uint8_t> scan_buffer_;  // a scan's CDR, reused from scan to scan
+  uint64_t clock_ = 0;                                  // log time: the newest stamp received
+  std::vector<uint8_t> scan_buffer_;                    // a scan's CDR, reused from scan to scan
 };
 
 }  // namespace lidarloop

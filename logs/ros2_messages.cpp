@@ -14,16 +14,24 @@ namespace lidarloop::ros2 {
 
 namespace {
 
-
 enum PointFieldType : uint8_t { INT8 = 1, UINT8, INT16, UINT16, INT32, UINT32, FLOAT32, FLOAT64 };
 
 size_t field_size(uint8_t datatype) {
   switch (datatype) {
-    case INT8: case UINT8: return 1;
-    case INT16: case UINT16: return 2;
-    case INT32: case UINT32: case FLOAT32: return 4;
-    case FLOAT64: return 8;
-    default: return 0;
+    case INT8:
+    case UINT8:
+      return 1;
+    case INT16:
+    case UINT16:
+      return 2;
+    case INT32:
+    case UINT32:
+    case FLOAT32:
+      return 4;
+    case FLOAT64:
+      return 8;
+    default:
+      return 0;
   }
 }
 
@@ -66,9 +74,7 @@ Eigen::Quaterniond quaternion(CdrReader& r) {
   return Eigen::Quaterniond(w, x, y, z);
 }
 
-Eigen::Quaterniond yaw_quaternion(double yaw) {
-  return Eigen::Quaterniond(std::cos(yaw / 2), 0, 0, std::sin(yaw / 2));
-}
+Eigen::Quaterniond yaw_quaternion(double yaw) { return Eigen::Quaterniond(std::cos(yaw / 2), 0, 0, std::sin(yaw / 2)); }
 
 void store32(uint8_t* p, uint32_t v) {
   for (int i = 0; i < 4; ++i) p[i] = uint8_t(v >> (8 * i));
@@ -82,14 +88,22 @@ uint64_t load(const uint8_t* p, size_t n) {
 
 double field_value(const uint8_t* p, uint8_t datatype) {
   switch (datatype) {
-    case INT8: return double(int8_t(p[0]));
-    case UINT8: return double(p[0]);
-    case INT16: return double(int16_t(load(p, 2)));
-    case UINT16: return double(load(p, 2));
-    case INT32: return double(int32_t(load(p, 4)));
-    case UINT32: return double(load(p, 4));
-    case FLOAT32: return double(std::bit_cast<float>(uint32_t(load(p, 4))));
-    default: return std::bit_cast<double>(load(p, 8));
+    case INT8:
+      return double(int8_t(p[0]));
+    case UINT8:
+      return double(p[0]);
+    case INT16:
+      return double(int16_t(load(p, 2)));
+    case UINT16:
+      return double(load(p, 2));
+    case INT32:
+      return double(int32_t(load(p, 4)));
+    case UINT32:
+      return double(load(p, 4));
+    case FLOAT32:
+      return double(std::bit_cast<float>(uint32_t(load(p, 4))));
+    default:
+      return std::bit_cast<double>(load(p, 8));
   }
 }
 
@@ -98,7 +112,9 @@ double clamp_to(double v, double hi) { return v > 0 ? std::min(v, hi) : 0.0; }  
 float to_float(double v) {
   if (std::isnan(v)) return std::numeric_limits<float>::quiet_NaN();
   const double big = std::numeric_limits<float>::max();
-  return v > big ? std::numeric_limits<float>::infinity() : v < -big ? -std::numeric_limits<float>::infinity() : float(v);
+  return v > big    ? std::numeric_limits<float>::infinity()
+         : v < -big ? -std::numeric_limits<float>::infinity()
+                    : float(v);
 }
 
 struct Field {
@@ -131,7 +147,7 @@ void encode_point_cloud(const PointCloud& cloud, const std::string& frame_id, By
     const char* name;
     uint32_t offset;
     uint8_t datatype;
-  } fields[] = {{"x", 0, FLOAT32},         {"y", 4, FLOAT32},   {"z", 8, FLOAT32},
+  } fields[] = {{"x", 0, FLOAT32},          {"y", 4, FLOAT32},    {"z", 8, FLOAT32},
                 {"intensity", 12, FLOAT32}, {"ring", 16, UINT16}, {"t_ns", 20, UINT32}};
   const size_t n = cloud.points.size();
   CdrWriter w(std::move(out));
@@ -183,13 +199,20 @@ PointCloud decode_point_cloud(View cdr, const std::string& context) {
     r.u32();  // count
     f.present = true;
     if (field_size(f.datatype) == 0) r.fail("PointCloud2 field '" + name + "' has unknown datatype");
-    if (name == "x") x = f;
-    else if (name == "y") y = f;
-    else if (name == "z") z = f;
-    else if (name == "intensity") intensity = f;
-    else if (name == "ring") ring = f;
-    else if (name == "t_ns" || name == "t" || name == "time_stamp") t_ns = f;
-    else if (name == "time") time = f;
+    if (name == "x")
+      x = f;
+    else if (name == "y")
+      y = f;
+    else if (name == "z")
+      z = f;
+    else if (name == "intensity")
+      intensity = f;
+    else if (name == "ring")
+      ring = f;
+    else if (name == "t_ns" || name == "t" || name == "time_stamp")
+      t_ns = f;
+    else if (name == "time")
+      time = f;
   }
   const bool big_endian = r.boolean();
   const uint32_t point_step = r.u32(), row_step = r.u32();

@@ -104,8 +104,7 @@ const std::map<std::string, std::string>& definitions() {
        "string child_frame_id\n"
        "geometry_msgs/PoseWithCovariance pose\n"
        "geometry_msgs/TwistWithCovariance twist\n"},
-      {"tf2_msgs/TFMessage",
-       "geometry_msgs/TransformStamped[] transforms\n"},
+      {"tf2_msgs/TFMessage", "geometry_msgs/TransformStamped[] transforms\n"},
       {"lidarloop_msgs/VehicleReport",
        "# One vehicle report from the CAN bus (layout in lidarloop's assets/vehicle_can.dbc).\n"
        "# header.stamp: when the frame arrived (measurement time plus bus latency).\n"
@@ -190,7 +189,8 @@ std::string schema_text(const std::string& type) {
 
 std::vector<std::string> known_types() {
   std::vector<std::string> out;
-  for (const auto& [name, def] : definitions()) out.push_back(name.substr(0, name.find('/')) + "/msg" + name.substr(name.find('/')));
+  for (const auto& [name, def] : definitions())
+    out.push_back(name.substr(0, name.find('/')) + "/msg" + name.substr(name.find('/')));
   return out;
 }
 

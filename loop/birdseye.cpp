@@ -35,7 +35,8 @@ void write_birdseye_png(const std::string& path, const PointCloud& cloud, const 
       cv::line(image, pixel(line[i - 1]), pixel(line[i]), cv::Scalar(80, 220, 80), 1, cv::LINE_AA);
 
   for (const auto& m : o.marks)
-    for (const auto& p : m.points) cv::circle(image, pixel(p), 2, cv::Scalar(m.bgr[0], m.bgr[1], m.bgr[2]), -1, cv::LINE_AA);
+    for (const auto& p : m.points)
+      cv::circle(image, pixel(p), 2, cv::Scalar(m.bgr[0], m.bgr[1], m.bgr[2]), -1, cv::LINE_AA);
   constexpr double kArrowLength = 4.0;  // m
   for (const auto& p : o.poses) {
     const Eigen::Vector2d from(p.pose.x, p.pose.y);

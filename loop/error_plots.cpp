@@ -20,8 +20,8 @@ constexpr int kMinWidth = 400, kMinHeight = 300;
 
 // Look: black ink on white, one font, anti-aliased.
 const cv::Scalar kWhite(255, 255, 255), kInk(30, 30, 30), kGrid(225, 225, 225), kZero(150, 150, 150),
-    kCurve(180, 90, 30), kTruth(120, 120, 120), kEstimate(60, 60, 60), kBackground(205, 205, 205),
-    kStart(40, 160, 40), kWorst(0, 0, 200);
+    kCurve(180, 90, 30), kTruth(120, 120, 120), kEstimate(60, 60, 60), kBackground(205, 205, 205), kStart(40, 160, 40),
+    kWorst(0, 0, 200);
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kTickFontScale = 0.5, kTitleFontScale = 0.65;
 
@@ -29,14 +29,14 @@ constexpr double kTickFontScale = 0.5, kTitleFontScale = 0.65;
 constexpr int kLeftMargin = 90, kRightMargin = 30, kTopMargin = 10, kBottomMargin = 50;
 constexpr int kPanelTitleHeight = 30, kPanelTickLabelHeight = 28, kTickLength = 5;
 constexpr int kTargetTimeTicks = 10, kTargetValueTicks = 5;
-constexpr double kValuePadFraction = 0.1;   // room above and below the curve
-constexpr double kMinHalfRange = 0.05;      // m or deg: an all-zero curve still gets an axis
+constexpr double kValuePadFraction = 0.1;  // room above and below the curve
+constexpr double kMinHalfRange = 0.05;     // m or deg: an all-zero curve still gets an axis
 constexpr double kMinTimeSpan_s = 1.0;
 
 // Trajectory plot layout.
 constexpr int kMapMargin = 50, kColourBarWidth = 24, kColourBarSpace = 130;
 constexpr double kMapPadFraction = 0.05, kMinMapExtent_m = 10.0;
-constexpr double kScaleBarFraction = 0.2;   // of the map's width, rounded down to 1-2-5
+constexpr double kScaleBarFraction = 0.2;  // of the map's width, rounded down to 1-2-5
 constexpr int kErrorLineThickness = 5, kMarkerRadius = 8;
 constexpr double kMinColourScale_m = 0.01;
 constexpr int kColourBarTicks = 5;
@@ -87,7 +87,8 @@ double tick_step(double span, int target) {
 
 std::vector<double> ticks(double lo, double hi, double step) {
   std::vector<double> out;
-  for (double v = std::ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) out.push_back(std::abs(v) < step * 1e-9 ? 0 : v);
+  for (double v = std::ceil(lo / step) * step; v <= hi + step * 1e-9; v += step)
+    out.push_back(std::abs(v) < step * 1e-9 ? 0 : v);
   return out;
 }
 
@@ -106,8 +107,8 @@ std::string fixed(double value, int decimals) {
 }
 
 struct Panel {
-  cv::Rect area;               // the plotting area inside the axes
-  double t0, t1, v0, v1;       // data ranges mapped onto it
+  cv::Rect area;          // the plotting area inside the axes
+  double t0, t1, v0, v1;  // data ranges mapped onto it
   cv::Point at(double t, double v) const {
     return {area.x + int(std::lround((t - t0) / (t1 - t0) * area.width)),
             area.y + area.height - int(std::lround((v - v0) / (v1 - v0) * area.height))};
@@ -173,8 +174,8 @@ void write_error_plot(const std::string& path, const std::vector<FrameError>& er
     const std::vector<double>* values;
     const char* name;
     const char* unit;
-  } panels[] = {{&lateral, "lateral error", "m"}, {&longitudinal, "longitudinal error", "m"},
-                {&heading, "heading error", "deg"}};
+  } panels[] = {
+      {&lateral, "lateral error", "m"}, {&longitudinal, "longitudinal error", "m"}, {&heading, "heading error", "deg"}};
   for (int k = 0; k < 3; ++k) {
     const auto& v = *panels[k].values;
     double lo = 0, hi = 0;  // the zero line is always in view
@@ -182,12 +183,12 @@ void write_error_plot(const std::string& path, const std::vector<FrameError>& er
       if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
     const double pad = std::max((hi - lo) * kValuePadFraction, kMinHalfRange);
     Panel p;
-    p.area = cv::Rect(kLeftMargin, kTopMargin + k * panel_step + kPanelTitleHeight, size.width - kLeftMargin - kRightMargin,
-                      panel_step - kPanelTitleHeight - kPanelTickLabelHeight);
+    p.area = cv::Rect(kLeftMargin, kTopMargin + k * panel_step + kPanelTitleHeight,
+                      size.width - kLeftMargin - kRightMargin, panel_step - kPanelTitleHeight - kPanelTickLabelHeight);
     p.t0 = t0, p.t1 = t1, p.v0 = lo - pad, p.v1 = hi + pad;
-    const std::string title = std::string(panels[k].name) + " (" + panels[k].unit + ")" +
-                              (v.empty() ? std::string(": no scored frames")
-                                         : ", RMSE " + fixed(rmse(v), 3) + " " + panels[k].unit);
+    const std::string title =
+        std::string(panels[k].name) + " (" + panels[k].unit + ")" +
+        (v.empty() ? std::string(": no scored frames") : ", RMSE " + fixed(rmse(v), 3) + " " + panels[k].unit);
     draw_panel(image, p, t, v, title);
   }
   text(image, "time (s)", {kLeftMargin + (size.width - kLeftMargin - kRightMargin) / 2, size.height - 12},
@@ -222,7 +223,8 @@ void write_trajectory_plot(const std::string& path, const std::vector<TruthPose>
   const double px_per_m = std::min(area.width / (2 * half_w), area.height / (2 * half_h));  // equal aspect
   const cv::Point centre(area.x + area.width / 2, area.y + area.height / 2);
   auto pixel = [&](double x, double y) {
-    return cv::Point(centre.x + int(std::lround((x - cx) * px_per_m)), centre.y - int(std::lround((y - cy) * px_per_m)));
+    return cv::Point(centre.x + int(std::lround((x - cx) * px_per_m)),
+                     centre.y - int(std::lround((y - cy) * px_per_m)));
   };
 
   // Clip to the map area so background lines do not run over the colour bar.
@@ -239,7 +241,8 @@ void write_trajectory_plot(const std::string& path, const std::vector<TruthPose>
   double max_error = 0;
   size_t worst = 0;
   for (size_t i = 0; i < errors.size(); ++i)
-    if (std::isfinite(errors[i].position_m) && errors[i].position_m > max_error) max_error = errors[i].position_m, worst = i;
+    if (std::isfinite(errors[i].position_m) && errors[i].position_m > max_error)
+      max_error = errors[i].position_m, worst = i;
   // The colour scale ends at the first 1-2-5 tick at or above the largest error.
   const double colour_step = tick_step(std::max(max_error, kMinColourScale_m), kColourBarTicks);
   const double scale_max = std::max(1.0, std::ceil(max_error / colour_step - 1e-9)) * colour_step;
@@ -260,7 +263,8 @@ void write_trajectory_plot(const std::string& path, const std::vector<TruthPose>
   if (!truth.empty())
     cv::circle(map, pixel(truth.front().pose.x, truth.front().pose.y) + offset, kMarkerRadius, kStart, 2, cv::LINE_AA);
   if (!errors.empty())
-    cv::circle(map, pixel(errors[worst].truth.x, errors[worst].truth.y) + offset, kMarkerRadius, kWorst, 2, cv::LINE_AA);
+    cv::circle(map, pixel(errors[worst].truth.x, errors[worst].truth.y) + offset, kMarkerRadius, kWorst, 2,
+               cv::LINE_AA);
   cv::rectangle(image, area, kInk, 1);
 
   // Scale bar, bottom left inside the map.

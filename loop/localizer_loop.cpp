@@ -75,7 +75,8 @@ class Localizers {
 // simulation waits for at scan k + 1 at the latest.
 class PipelinedSink : public StreamSink {
  public:
-  PipelinedSink(Localizers& localizers, StreamSink* also, const std::function<void(const LocalizerEstimate&)>& on_estimate)
+  PipelinedSink(Localizers& localizers, StreamSink* also,
+                const std::function<void(const LocalizerEstimate&)>& on_estimate)
       : localizers_(localizers), also_(also), on_estimate_(on_estimate), worker_([this] { work(); }) {}
   ~PipelinedSink() override { stop(); }
 
@@ -181,9 +182,9 @@ class PipelinedSink : public StreamSink {
   Localizers& localizers_;
   StreamSink* also_;
   std::function<void(const LocalizerEstimate&)> on_estimate_;
-  bool scan_outstanding_ = false;              // simulation thread only
-  std::vector<std::function<void()>> held_;    // simulation thread only
-  std::mutex mutex_;                           // guards the four below
+  bool scan_outstanding_ = false;            // simulation thread only
+  std::vector<std::function<void()>> held_;  // simulation thread only
+  std::mutex mutex_;                         // guards the four below
   std::condition_variable wake_worker_, estimate_ready_;
   std::deque<Message> queue_;
   std::deque<LocalizerEstimate> estimates_;
@@ -238,8 +239,8 @@ class DelayedPose {
   // `o` driven on to t_ns in the localizer's Euler steps.
   Odometry advanced(Odometry o, int64_t t_ns) const {
     if (t_ns <= o.stamp_ns) return o;
-    o.pose = o.predictor.advance(o.pose, o.motion.speed, o.motion.steer, t_ns - o.stamp_ns,
-                                 params_.max_prediction_step_s);
+    o.pose =
+        o.predictor.advance(o.pose, o.motion.speed, o.motion.steer, t_ns - o.stamp_ns, params_.max_prediction_step_s);
     o.stamp_ns = t_ns;
     return o;
   }

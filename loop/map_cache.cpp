@@ -1,11 +1,11 @@
 #include "loop/map_cache.hpp"
 
+#include <unistd.h>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -93,11 +93,13 @@ void write_intensity_pngs(const std::string& map_dir, const std::string& mean_pn
   const IntensityMapHeader& h = map.header();
   if (h.tiles.empty()) throw InputError(map_dir + ": the map has no tiles");
   int tx0 = INT32_MAX, ty0 = INT32_MAX, tx1 = INT32_MIN, ty1 = INT32_MIN;
-  for (const auto& [tx, ty] : h.tiles) tx0 = std::min(tx0, tx), ty0 = std::min(ty0, ty), tx1 = std::max(tx1, tx), ty1 = std::max(ty1, ty);
+  for (const auto& [tx, ty] : h.tiles)
+    tx0 = std::min(tx0, tx), ty0 = std::min(ty0, ty), tx1 = std::max(tx1, tx), ty1 = std::max(ty1, ty);
   const int cells_x = (tx1 - tx0 + 1) * h.tile_cells, cells_y = (ty1 - ty0 + 1) * h.tile_cells;
   const int step = std::max(1, (std::max(cells_x, cells_y) + max_pixels - 1) / max_pixels);
   const int w = cells_x / step, hgt = cells_y / step;
-  cv::Mat mean(hgt, w, CV_8UC1, cv::Scalar(0)), var(hgt, w, CV_8UC1, cv::Scalar(0)), seen(hgt, w, CV_8UC1, cv::Scalar(0));
+  cv::Mat mean(hgt, w, CV_8UC1, cv::Scalar(0)), var(hgt, w, CV_8UC1, cv::Scalar(0)),
+      seen(hgt, w, CV_8UC1, cv::Scalar(0));
   constexpr double kMeanScale = 255.0 / 60.0, kVarianceScale = 255.0 / 200.0;  // intensity counts, counts^2
   for (int py = 0; py < hgt; ++py)
     for (int px = 0; px < w; ++px) {

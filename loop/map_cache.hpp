@@ -11,9 +11,9 @@ namespace lidarloop {
 std::string map_cache_root();
 
 struct MapLocation {
-  std::string dir;      // <root>/<world>-<hash>
+  std::string dir;  // <root>/<world>-<hash>
   std::string hash;
-  bool built = false;   // built now (false: found in the cache)
+  bool built = false;  // built now (false: found in the cache)
   double build_s = 0;
 };
 

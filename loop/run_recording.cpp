@@ -20,13 +20,13 @@ std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>&
   McapRecorder& log = recorder->log();
   log.add_attachment(kScenarioAttachment, "application/yaml", scenario.text);
   log.add_metadata(kRunMetadata, {{"scenario", scenario.file},
-                                        {"world", scenario.world},
-                                        {"seed", std::to_string(scenario.seed)},
-                                        {"duration_s", std::to_string(scenario.duration_s)},
-                                        {"method", method},
-                                        {"loop", scenario.closed_loop ? "closed" : "open"},
-                                        {"map_hash", map_hash(scenario.world, MappingOptions{})},
-                                        {"version", LIDARLOOP_VERSION}});
+                                  {"world", scenario.world},
+                                  {"seed", std::to_string(scenario.seed)},
+                                  {"duration_s", std::to_string(scenario.duration_s)},
+                                  {"method", method},
+                                  {"loop", scenario.closed_loop ? "closed" : "open"},
+                                  {"map_hash", map_hash(scenario.world, MappingOptions{})},
+                                  {"version", LIDARLOOP_VERSION}});
   return recorder;
 }
 

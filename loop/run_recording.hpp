@@ -18,10 +18,22 @@ inline constexpr const char* kRunMetadata = "lidarloop.run";
 class TeeSink : public StreamSink {
  public:
   TeeSink(StreamSink& a, StreamSink* b) : a_(a), b_(b) {}
-  void on_truth(const TruthSample& t) override { a_.on_truth(t); if (b_) b_->on_truth(t); }
-  void on_can(const CanFrame& f) override { a_.on_can(f); if (b_) b_->on_can(f); }
-  void on_gps(const GpsFix& f) override { a_.on_gps(f); if (b_) b_->on_gps(f); }
-  void on_rtk(const GpsFix& f) override { a_.on_rtk(f); if (b_) b_->on_rtk(f); }
+  void on_truth(const TruthSample& t) override {
+    a_.on_truth(t);
+    if (b_) b_->on_truth(t);
+  }
+  void on_can(const CanFrame& f) override {
+    a_.on_can(f);
+    if (b_) b_->on_can(f);
+  }
+  void on_gps(const GpsFix& f) override {
+    a_.on_gps(f);
+    if (b_) b_->on_gps(f);
+  }
+  void on_rtk(const GpsFix& f) override {
+    a_.on_rtk(f);
+    if (b_) b_->on_rtk(f);
+  }
   void on_scan(const PointCloud& c, const Eigen::Isometry3d& pose) override {
     a_.on_scan(c, pose);
     if (b_) b_->on_scan(c, pose);
@@ -56,6 +68,6 @@ class RecordingSink : public StreamSink {
 
 // Null when `path` is empty. `method` is the localizer's, empty for `simulate`.
 std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>& path, const Scenario& scenario,
-                                              const std::string& method);
+                                               const std::string& method);
 
 }  // namespace lidarloop

@@ -28,8 +28,7 @@ CanModel::CanModel(const CanConfig& config, uint64_t seed) : config_(config), rn
   require(config.wheel_speed_noise_mps >= 0 && config.steering_noise_rad >= 0, "noise must not be negative");
   require(config.wheel_speed_scale_error > -1, "wheel_speed_scale_error must be > -1");
   require(config.latency_ns >= 0, "latency must not be negative");
-  require(config.dropout_probability >= 0 && config.dropout_probability < 1,
-          "dropout_probability must be in [0, 1)");
+  require(config.dropout_probability >= 0 && config.dropout_probability < 1, "dropout_probability must be in [0, 1)");
 }
 
 void CanModel::measure(int64_t t_ns, const std::array<double, 4>& wheel_speeds_mps, double steering_wheel_angle_rad) {

@@ -14,15 +14,15 @@ namespace lidarloop {
 
 struct CanConfig {
   double rate_hz = 100.0;
-  double wheel_speed_resolution_mps = 0.01;   // quantisation step
-  double wheel_speed_noise_mps = 0.02;        // 1 sigma, white
-  double wheel_speed_scale_error = 0.005;     // reported = true * (1 + this): tyre radius error
-  double min_detectable_speed_mps = 0.1;      // below this a wheel reads 0 (too few encoder pulses)
-  double steering_resolution_rad = 0.0017;    // ~0.1 deg at the steering wheel
-  double steering_noise_rad = 0.002;          // 1 sigma at the steering wheel
-  double steering_offset_rad = 0.0;           // constant bias at the steering wheel
-  int64_t latency_ns = 10'000'000;            // measurement to arrival
-  double dropout_probability = 0.0;           // per frame
+  double wheel_speed_resolution_mps = 0.01;  // quantisation step
+  double wheel_speed_noise_mps = 0.02;       // 1 sigma, white
+  double wheel_speed_scale_error = 0.005;    // reported = true * (1 + this): tyre radius error
+  double min_detectable_speed_mps = 0.1;     // below this a wheel reads 0 (too few encoder pulses)
+  double steering_resolution_rad = 0.0017;   // ~0.1 deg at the steering wheel
+  double steering_noise_rad = 0.002;         // 1 sigma at the steering wheel
+  double steering_offset_rad = 0.0;          // constant bias at the steering wheel
+  int64_t latency_ns = 10'000'000;           // measurement to arrival
+  double dropout_probability = 0.0;          // per frame
 };
 
 class CanModel {

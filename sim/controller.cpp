@@ -59,9 +59,9 @@ ControllerCommand PathController::update(int64_t t_ns, const Pose2d& rear, doubl
   const double cross_track = (rear_xy - Eigen::Vector2d(on_path.x, on_path.y)).dot(left);
   const double kappa = path_.curvature_at(progress_ + speed * p_.preview_s);
   const double a_lat = speed * speed * kappa;
-  const double K = vehicle_.mass / wheelbase *
-                   (vehicle_.lr / (2 * vehicle_.cornering_stiffness_front) -
-                    vehicle_.lf / (2 * vehicle_.cornering_stiffness_rear));
+  const double K =
+      vehicle_.mass / wheelbase *
+      (vehicle_.lr / (2 * vehicle_.cornering_stiffness_front) - vehicle_.lf / (2 * vehicle_.cornering_stiffness_rear));
   const double rear_slip = vehicle_.mass * vehicle_.lf * a_lat / (2 * vehicle_.cornering_stiffness_rear * wheelbase);
   const double feed_forward = std::atan(wheelbase * kappa) + K * a_lat;
   const double heading_error = wrap_angle(on_path.yaw + rear_slip - rear.yaw);

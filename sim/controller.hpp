@@ -19,22 +19,22 @@
 namespace lidarloop {
 
 struct ControllerParams {
-  double stanley_gain = 1.5;         // 1/s: cross-track error to steering
-  double stanley_softening = 1.0;    // m/s: keeps the gain finite at low speed
+  double stanley_gain = 1.5;       // 1/s: cross-track error to steering
+  double stanley_softening = 1.0;  // m/s: keeps the gain finite at low speed
   double heading_gain = 1.0;
-  double preview_s = 0.15;           // look ahead to make up for the steering actuator's lag
-  double speed_kp = 0.8;             // (m/s^2) per (m/s)
-  double speed_ki = 0.1;             // (m/s^2) per m
-  double max_lateral_accel = 2.0;    // m/s^2 on curves
-  double comfort_decel = 2.0;        // m/s^2 towards stops
-  double stop_tolerance = 0.3;       // m: close enough to a stop line
+  double preview_s = 0.15;         // look ahead to make up for the steering actuator's lag
+  double speed_kp = 0.8;           // (m/s^2) per (m/s)
+  double speed_ki = 0.1;           // (m/s^2) per m
+  double max_lateral_accel = 2.0;  // m/s^2 on curves
+  double comfort_decel = 2.0;      // m/s^2 towards stops
+  double stop_tolerance = 0.3;     // m: close enough to a stop line
 };
 
 struct ControllerCommand {
   VehicleCommand command;
-  double progress = 0;        // arc length of the vehicle on its path, m (unwrapped on closed paths)
-  double cross_track = 0;     // signed lateral error of the rear axle, m (left positive)
-  bool finished = false;      // reached the end of an open path and stopped
+  double progress = 0;     // arc length of the vehicle on its path, m (unwrapped on closed paths)
+  double cross_track = 0;  // signed lateral error of the rear axle, m (left positive)
+  bool finished = false;   // reached the end of an open path and stopped
 };
 
 class PathController {
@@ -54,7 +54,7 @@ class PathController {
   std::vector<Wait> stops_;
   VehicleParams vehicle_;
   ControllerParams p_;
-  double progress_ = -1;       // unwrapped arc length, -1 before the first update
+  double progress_ = -1;  // unwrapped arc length, -1 before the first update
   double integral_ = 0;
   int64_t last_ns_ = -1;
   size_t next_stop_ = 0;

@@ -33,8 +33,7 @@ double gauss_markov_step(double b, double dt_s, double sigma, double tau_s, doub
 int64_t period_for(double rate_hz) { return std::llround(kNanosecondsPerSecond / rate_hz); }
 
 bool zone_applies(const GpsZone& zone, int64_t t_ns, const Pose2d& truth) {
-  const bool in_space =
-      zone.radius_m == 0 || (Eigen::Vector2d(truth.x, truth.y) - zone.centre).norm() <= zone.radius_m;
+  const bool in_space = zone.radius_m == 0 || (Eigen::Vector2d(truth.x, truth.y) - zone.centre).norm() <= zone.radius_m;
   return in_space && zone.from_ns <= t_ns && t_ns < zone.to_ns;
 }
 
@@ -85,8 +84,10 @@ GpsFix GpsModel::sample(int64_t t_ns, const Pose2d& truth) {
   Eigen::Vector2d jump{0, 0};  // multipath jumps of overlapping zones add up
   for (const GpsZone& zone : config_.zones) {
     if (!zone_applies(zone, t_ns, truth)) continue;
-    if (zone.kind == GpsZone::Kind::outage) outage = true;
-    else jump += zone.jump_m;
+    if (zone.kind == GpsZone::Kind::outage)
+      outage = true;
+    else
+      jump += zone.jump_m;
   }
 
   GpsFix fix;
@@ -101,8 +102,7 @@ GpsFix GpsModel::sample(int64_t t_ns, const Pose2d& truth) {
 
   const Eigen::Vector2d white = config_.white_sigma_m * Eigen::Vector2d(n_white_e, n_white_n);
   const Eigen::Vector2d measured = Eigen::Vector2d(truth.x, truth.y) + bias_ + white + jump;
-  const Geodetic g =
-      frame_.to_geodetic(measured, frame_.origin().alt_m + config_.vertical_sigma_m * n_white_u);
+  const Geodetic g = frame_.to_geodetic(measured, frame_.origin().alt_m + config_.vertical_sigma_m * n_white_u);
   fix.status = GpsStatus::fix;
   fix.lat_deg = g.lat_deg;
   fix.lon_deg = g.lon_deg;

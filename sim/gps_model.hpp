@@ -24,18 +24,18 @@ struct GpsZone {
   Kind kind = Kind::outage;
   // Where: a circle in the local frame (radius > 0), and/or a time window; both must hold when both are set.
   Eigen::Vector2d centre{0, 0};
-  double radius_m = 0;                   // 0: everywhere
+  double radius_m = 0;  // 0: everywhere
   int64_t from_ns = 0, to_ns = INT64_MAX;
-  Eigen::Vector2d jump_m{0, 0};          // multipath: added to the position (east, north)
+  Eigen::Vector2d jump_m{0, 0};  // multipath: added to the position (east, north)
 };
 
 struct GpsConfig {
   double rate_hz = 10.0;
-  double bias_sigma_m = 2.0;             // per horizontal axis, stationary 1 sigma
-  double bias_tau_s = 120.0;             // correlation time
-  double white_sigma_m = 0.4;            // per horizontal axis
-  double vertical_sigma_m = 3.0;         // white, on altitude
-  double heading_bias_sigma_rad = 0.026; // ~1.5 deg
+  double bias_sigma_m = 2.0;              // per horizontal axis, stationary 1 sigma
+  double bias_tau_s = 120.0;              // correlation time
+  double white_sigma_m = 0.4;             // per horizontal axis
+  double vertical_sigma_m = 3.0;          // white, on altitude
+  double heading_bias_sigma_rad = 0.026;  // ~1.5 deg
   double heading_bias_tau_s = 60.0;
   double heading_white_sigma_rad = 0.017;
   std::vector<GpsZone> zones;

@@ -31,12 +31,30 @@ Eigen::Isometry3d Hdl32eConfig::mount() const {
 
 void read_hdl32e_config(const YamlReader& y, const YAML::Node& n, Hdl32eConfig& c) {
   y.expect_map(n, "lidar");
-  y.allow_keys(n, {"elevation_deg", "firing_order", "firing_period_ns", "slots_per_cycle", "rotation_hz",
-                   "scan_start_yaw_deg", "min_range_m", "max_range_m", "range_resolution_m", "range_noise_m",
-                   "dark_target_reflectivity", "dark_target_range_m", "detection_incidence_exponent",
-                   "detection_softness", "max_incidence_deg", "intensity_incidence_exponent",
-                   "intensity_reference_range_m", "intensity_range_exponent", "intensity_noise",
-                   "laser_gain_spread", "unit_serial", "mount_xyz", "mount_rpy_deg", "motion_distortion",
+  y.allow_keys(n, {"elevation_deg",
+                   "firing_order",
+                   "firing_period_ns",
+                   "slots_per_cycle",
+                   "rotation_hz",
+                   "scan_start_yaw_deg",
+                   "min_range_m",
+                   "max_range_m",
+                   "range_resolution_m",
+                   "range_noise_m",
+                   "dark_target_reflectivity",
+                   "dark_target_range_m",
+                   "detection_incidence_exponent",
+                   "detection_softness",
+                   "max_incidence_deg",
+                   "intensity_incidence_exponent",
+                   "intensity_reference_range_m",
+                   "intensity_range_exponent",
+                   "intensity_noise",
+                   "laser_gain_spread",
+                   "unit_serial",
+                   "mount_xyz",
+                   "mount_rpy_deg",
+                   "motion_distortion",
                    "cycles_per_actor_update"});
   if (const YAML::Node e = n["elevation_deg"]) {
     if (!e.IsSequence() || e.size() != kHdl32eLasers) y.fail(e, "elevation_deg must list 32 elevations");

@@ -33,21 +33,21 @@ struct Hdl32eConfig {
   double dark_target_reflectivity = 0.10;
   double dark_target_range_m = 70.0;
   double detection_incidence_exponent = 0.5;
-  double detection_softness = 0.15;   // width of the detection ramp in log power
-  double max_incidence_deg = 87.0;    // grazing returns beyond this are lost
+  double detection_softness = 0.15;  // width of the detection ramp in log power
+  double max_incidence_deg = 87.0;   // grazing returns beyond this are lost
   // Intensity: 100 * reflectivity * cos(incidence)^intensity_incidence_exponent * laser gain
   //            * min(1, intensity_reference_range_m / range)^intensity_range_exponent + noise.
   double intensity_incidence_exponent = 0.5;
   double intensity_reference_range_m = 10.0;
   double intensity_range_exponent = 0.25;
-  double intensity_noise = 1.5;       // counts, 1 sigma
-  double laser_gain_spread = 0.08;    // per-laser gains uniform in 1 +- spread, fixed by the unit's serial
+  double intensity_noise = 1.5;     // counts, 1 sigma
+  double laser_gain_spread = 0.08;  // per-laser gains uniform in 1 +- spread, fixed by the unit's serial
   uint64_t unit_serial = 1;
 
   // Sensor pose in the vehicle frame (origin at the rear axle centre on the ground).
   Eigen::Vector3d mount_xyz{1.2, 0.0, 1.9};
   Eigen::Vector3d mount_rpy_deg{0.0, 0.0, 0.0};
-  bool motion_distortion = true;      // cast each firing from the pose at its own time
+  bool motion_distortion = true;  // cast each firing from the pose at its own time
   // Actor poses are keyframed every this many firing cycles (1.47 ms) and interpolated linearly in
   // between; raised automatically if a scan would need more keyframes than Embree allows.
   int cycles_per_actor_update = 32;

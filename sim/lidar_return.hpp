@@ -25,7 +25,7 @@ class ReturnModel {
 
  private:
   Hdl32eConfig c_;
-  double min_power_;        // reflectivity / range^2 of a target detected half the time
+  double min_power_;  // reflectivity / range^2 of a target detected half the time
   double min_cos_incidence_;
   double sure_miss_, sure_hit_;  // detection margins beyond which no random draw is needed
   std::array<double, kHdl32eLasers> gain_;

@@ -8,7 +8,6 @@
 
 namespace lidarloop {
 
-
 PoseAt constant_twist(const Eigen::Isometry3d& start, int64_t t0_ns, double v, double w) {
   return [=](int64_t t_ns) {
     const double t = double(t_ns - t0_ns) * 1e-9;
@@ -35,8 +34,8 @@ LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& mate
                                             float(std::cos(elevation) * std::sin(yaw)), float(std::sin(elevation)));
   }
   const int cycles = config.cycles_per_scan();
-  const int per_keyframe = std::max(config.cycles_per_actor_update,
-                                    (cycles + RayScene::kMaxKeyframes - 2) / (RayScene::kMaxKeyframes - 1));
+  const int per_keyframe =
+      std::max(config.cycles_per_actor_update, (cycles + RayScene::kMaxKeyframes - 2) / (RayScene::kMaxKeyframes - 1));
   keyframes_ = (cycles + per_keyframe - 1) / per_keyframe + 1;
   keyframe_step_ns_ = per_keyframe * config.cycle_period_ns();
   for (int cycle = 0; cycle < cycles; ++cycle) {
@@ -118,8 +117,8 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
           const auto ret = returns_(materials_[hits[k].material], hits[k].range, cos_incidence, ring, rng, i);
           if (!ret) continue;
           const Eigen::Vector3f p = sensor_direction(cycle, slot) * ret->range;
-          points[i] = {p.x(), p.y(), p.z(), ret->intensity, uint16_t(ring),
-                       uint32_t(config_.firing_time_ns(cycle, slot))};
+          points[i] = {p.x(),          p.y(),          p.z(),
+                       ret->intensity, uint16_t(ring), uint32_t(config_.firing_time_ns(cycle, slot))};
           valid[i] = 1;
         }
       }

@@ -61,7 +61,7 @@ class LidarScanner {
   // Per firing slot: the beam's unit vector at zero yaw, with the slot's own yaw advance folded in.
   std::array<Eigen::Vector3f, kHdl32eLasers> slot_direction_;
   std::vector<Eigen::Vector2f> cycle_yaw_;  // (cos, sin) of each cycle's starting yaw
-  int keyframes_ = 2;                        // actor keyframes per scan, evenly spaced from the stamp
+  int keyframes_ = 2;                       // actor keyframes per scan, evenly spaced from the stamp
   int64_t keyframe_step_ns_ = 0;
 };
 

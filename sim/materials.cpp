@@ -25,8 +25,7 @@ MaterialTable MaterialTable::load(const std::string& path) {
     table.materials_.push_back(m);
   }
   if (table.materials_.empty()) throw InputError(path + ": no materials defined");
-  if (table.materials_.size() > std::numeric_limits<MaterialId>::max())
-    throw InputError(path + ": too many materials");
+  if (table.materials_.size() > std::numeric_limits<MaterialId>::max()) throw InputError(path + ": too many materials");
   return table;
 }
 

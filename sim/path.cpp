@@ -107,8 +107,10 @@ Path lane_path(const RoadSpec& road, Lane lane, bool backward, const double* off
   } else {
     const double lane_width = road.width / road.lanes;
     const double outer = road.width / 2 - lane_width / 2;  // the lane along the curb
-    if (road.one_way) lateral = lane == Lane::right ? -outer : outer;
-    else lateral = lane == Lane::right ? -outer : -(road.lanes >= 2 ? lane_width / 2 : outer);
+    if (road.one_way)
+      lateral = lane == Lane::right ? -outer : outer;
+    else
+      lateral = lane == Lane::right ? -outer : -(road.lanes >= 2 ? lane_width / 2 : outer);
     if (road.lanes == 1 && !road.one_way) lateral = 0;
     if (backward) lateral = -lateral;
   }

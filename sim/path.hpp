@@ -13,13 +13,13 @@
 namespace lidarloop {
 
 struct Path {
-  Polyline2d points;    // closed paths repeat their first point
+  Polyline2d points;  // closed paths repeat their first point
   bool closed = false;
   double length = 0;
   std::vector<double> arc;  // arc length at each point
 
-  Pose2d pose_at(double s) const;          // position and heading at arc length s (wrapped if closed)
-  double curvature_at(double s) const;     // signed (left positive), averaged over a few metres
+  Pose2d pose_at(double s) const;       // position and heading at arc length s (wrapped if closed)
+  double curvature_at(double s) const;  // signed (left positive), averaged over a few metres
   // Arc length of the point nearest to p among the segments within [from, to] (wrapped if closed).
   double project(const Eigen::Vector2d& p, double from, double to) const;
   double project(const Eigen::Vector2d& p) const { return project(p, 0, length); }

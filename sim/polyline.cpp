@@ -77,8 +77,10 @@ Polyline2d fillet_polyline(const Polyline2d& line, double radius, bool closed, d
       out.push_back(centre + Eigen::Rotation2D<double>(angle) * r0);
     }
   }
-  if (closed) out.push_back(out.front());
-  else out.push_back(line.back());
+  if (closed)
+    out.push_back(out.front());
+  else
+    out.push_back(line.back());
   return out;
 }
 
@@ -96,9 +98,12 @@ Polyline2d offset_polyline(const Polyline2d& line, double offset, bool closed) {
   for (size_t i = 0; i < n; ++i) {
     const bool interior = i > 0 && i + 1 < n;
     Eigen::Vector2d nrm;
-    if (interior) nrm = mitre(normal(i - 1), normal(i));
-    else if (closed) nrm = mitre(normal(n - 2), normal(0));  // first point == last point
-    else nrm = normal(i == 0 ? 0 : n - 2);
+    if (interior)
+      nrm = mitre(normal(i - 1), normal(i));
+    else if (closed)
+      nrm = mitre(normal(n - 2), normal(0));  // first point == last point
+    else
+      nrm = normal(i == 0 ? 0 : n - 2);
     out.push_back(line[i] + offset * nrm);
   }
   return out;

@@ -9,7 +9,8 @@ namespace lidarloop {
 
 static void check_device(RTCDevice device, const char* what) {
   const RTCError err = rtcGetDeviceError(device);
-  if (err != RTC_ERROR_NONE) throw std::runtime_error(std::string("Embree error ") + std::to_string(err) + " in " + what);
+  if (err != RTC_ERROR_NONE)
+    throw std::runtime_error(std::string("Embree error ") + std::to_string(err) + " in " + what);
 }
 
 RayScene::RayScene(const TriangleMesh& world, int threads) {
@@ -89,8 +90,10 @@ void RayScene::set_actor_visible(int actor, bool visible) {
   Actor& a = instances_.at(actors_.at(actor));
   if (a.visible == visible) return;
   a.visible = visible;
-  if (visible) rtcEnableGeometry(a.instance);
-  else rtcDisableGeometry(a.instance);
+  if (visible)
+    rtcEnableGeometry(a.instance);
+  else
+    rtcDisableGeometry(a.instance);
 }
 
 void RayScene::commit() {
@@ -98,8 +101,7 @@ void RayScene::commit() {
   check_device(device_, "committing the scene");
 }
 
-RayHit RayScene::make_hit(unsigned inst_id, unsigned prim_id, float tfar, const Eigen::Vector3f& ng,
-                          float time) const {
+RayHit RayScene::make_hit(unsigned inst_id, unsigned prim_id, float tfar, const Eigen::Vector3f& ng, float time) const {
   const Actor& inst = instances_[instance_of_geom_[inst_id]];
   // Embree reports instanced normals in the instance's object space; the nearest keyframe's
   // rotation is close enough for an incidence angle.

@@ -10,8 +10,8 @@
 // a whole scan is cast in one parallel pass with every actor where it was at that ray's instant.
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <embree3/rtcore.h>
+#include <Eigen/Geometry>
 
 #include "sim/triangle_mesh.hpp"
 
@@ -23,7 +23,7 @@ struct Ray {
 };
 
 struct RayHit {
-  float range = 0;                // along the (unit) ray direction
+  float range = 0;                  // along the (unit) ray direction
   Eigen::Vector3f normal{0, 0, 1};  // unit, world frame
   MaterialId material = 0;
 };
@@ -74,10 +74,10 @@ class RayScene {
 
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;
-  std::vector<Prototype> prototypes_;   // [0] is the static world
-  std::vector<Actor> instances_;        // [0] is the static world's instance
-  std::vector<int> actors_;             // actor id -> index into instances_
-  std::vector<int> instance_of_geom_;   // top-level geomID -> index into instances_
+  std::vector<Prototype> prototypes_;  // [0] is the static world
+  std::vector<Actor> instances_;       // [0] is the static world's instance
+  std::vector<int> actors_;            // actor id -> index into instances_
+  std::vector<int> instance_of_geom_;  // top-level geomID -> index into instances_
   size_t world_triangles_ = 0;
 };
 

@@ -30,8 +30,8 @@ std::vector<Wait> read_waits(const YamlReader& y, const YAML::Node& n, const cha
 
 PathSpec read_path(const YamlReader& y, const YAML::Node& n, const char* what) {
   y.expect_map(n, what);
-  y.allow_keys(n, {"road", "lane", "direction", "offset", "waypoints", "smoothing_radius", "closed", "crosswalk",
-                   "from"});
+  y.allow_keys(n,
+               {"road", "lane", "direction", "offset", "waypoints", "smoothing_radius", "closed", "crosswalk", "from"});
   PathSpec p;
   p.where = yaml_location(y.file(), n);
   const int kinds = int(bool(n["road"])) + int(bool(n["waypoints"])) + int(bool(n["crosswalk"]));
@@ -77,8 +77,8 @@ PathSpec read_path(const YamlReader& y, const YAML::Node& n, const char* what) {
 void read_can(const YamlReader& y, const YAML::Node& n, CanConfig& c) {
   y.expect_map(n, "can");
   y.allow_keys(n, {"rate_hz", "wheel_speed_resolution_mps", "wheel_speed_noise_mps", "wheel_speed_scale_error",
-                   "min_detectable_speed_mps", "steering_resolution_rad", "steering_noise_rad", "steering_offset_rad", "latency_ms",
-                   "dropout_probability"});
+                   "min_detectable_speed_mps", "steering_resolution_rad", "steering_noise_rad", "steering_offset_rad",
+                   "latency_ms", "dropout_probability"});
   y.read_number(n, "rate_hz", c.rate_hz, 1.0, 1000.0);
   y.read_number(n, "wheel_speed_resolution_mps", c.wheel_speed_resolution_mps, 0.0, 1.0);
   y.read_number(n, "wheel_speed_noise_mps", c.wheel_speed_noise_mps, 0.0, 5.0);
@@ -122,8 +122,10 @@ void read_gps(const YamlReader& y, const YAML::Node& n, GpsConfig& g) {
       if (z["to_s"]) zone.to_ns = int64_t(y.number_in(z["to_s"], "to_s", 0.0, kMaxDuration) * 1e9);
       if (zone.to_ns <= zone.from_ns) y.fail(z, "a zone's to_s must be after its from_s");
       if (!z["centre"] && !z["from_s"] && !z["to_s"]) y.fail(z, "a zone needs a centre and radius, or from_s/to_s");
-      if (zone.kind == GpsZone::Kind::multipath) zone.jump_m = y.vec2(y.required(z, "jump"), "jump");
-      else if (z["jump"]) y.fail(z["jump"], "jump applies only to multipath zones");
+      if (zone.kind == GpsZone::Kind::multipath)
+        zone.jump_m = y.vec2(y.required(z, "jump"), "jump");
+      else if (z["jump"])
+        y.fail(z["jump"], "jump applies only to multipath zones");
       g.zones.push_back(zone);
     }
   }
@@ -134,7 +136,8 @@ void read_rtk(const YamlReader& y, const YAML::Node& n, RtkConfig& r) {
   y.allow_keys(n, {"rate_hz", "sigma_m", "heading_sigma_deg"});
   if (n["rate_hz"]) r.rate_hz = y.number_in(n["rate_hz"], "rate_hz", 0.1, 100.0);
   if (n["sigma_m"]) r.sigma_m = y.number_in(n["sigma_m"], "sigma_m", 0.0, 1.0);
-  if (n["heading_sigma_deg"]) r.heading_sigma_rad = y.number_in(n["heading_sigma_deg"], "heading_sigma_deg", 0.0, 10.0) * kDeg;
+  if (n["heading_sigma_deg"])
+    r.heading_sigma_rad = y.number_in(n["heading_sigma_deg"], "heading_sigma_deg", 0.0, 10.0) * kDeg;
 }
 
 EgoSpec read_ego(const YamlReader& y, const YAML::Node& n, const VehicleParams& vehicle) {
@@ -276,8 +279,7 @@ void check_on_network(const Path& path, const region::Paths& area, const std::st
     const Pose2d p = path.pose_at(s);
     if (!region::contains(area, {p.x, p.y}))
       throw InputError(where + ": " + what + " leaves the road network at (" + std::to_string(int(std::lround(p.x))) +
-                       ", " + std::to_string(int(std::lround(p.y))) + "), " + std::to_string(int(s)) +
-                       " m along it");
+                       ", " + std::to_string(int(std::lround(p.y))) + "), " + std::to_string(int(s)) + " m along it");
   }
 }
 
@@ -305,8 +307,7 @@ ResolvedScenario resolve_scenario(const Scenario& s, const WorldDescription& d, 
     plan.type = a.type;
     if (a.parked) {
       if (!world.bounds.contains(a.position)) throw InputError(a.where + ": parked actor is outside the world");
-      plan.path = make_path({a.position, a.position + Eigen::Vector2d(std::cos(a.yaw), std::sin(a.yaw)) * 1e-3},
-                            false);
+      plan.path = make_path({a.position, a.position + Eigen::Vector2d(std::cos(a.yaw), std::sin(a.yaw)) * 1e-3}, false);
     } else {
       plan.path = build_path(a.path, d);
       const bool on_foot = a.type == ActorType::pedestrian || a.type == ActorType::cyclist;

@@ -39,22 +39,22 @@ struct TrafficSpec {
   std::string where;
   ActorType type = ActorType::car;
   bool parked = false;
-  PathSpec path;                       // when moving
-  Eigen::Vector2d position{0, 0};      // when parked
-  double yaw = 0;                      // when parked, rad
-  double start_at = 0;                 // arc length on the path at t = 0, m
-  double speed = 0;                    // m/s
-  double depart_s = 0;                 // when it starts moving
+  PathSpec path;                   // when moving
+  Eigen::Vector2d position{0, 0};  // when parked
+  double yaw = 0;                  // when parked, rad
+  double start_at = 0;             // arc length on the path at t = 0, m
+  double speed = 0;                // m/s
+  double depart_s = 0;             // when it starts moving
   std::vector<Wait> waits;
 };
 
 struct EgoSpec {
   std::string where;
   PathSpec route;
-  double start_at = 0;                 // arc length on the route where the rear axle starts, m
-  double speed = 10.0;                 // cruise speed, m/s
-  double initial_speed = 0;            // m/s at t = 0
-  std::vector<Wait> stops;             // arc lengths along the route (unwrapped on loops)
+  double start_at = 0;       // arc length on the route where the rear axle starts, m
+  double speed = 10.0;       // cruise speed, m/s
+  double initial_speed = 0;  // m/s at t = 0
+  std::vector<Wait> stops;   // arc lengths along the route (unwrapped on loops)
   VehicleParams vehicle;
   ControllerParams controller;
 };
@@ -71,8 +71,8 @@ struct PassThresholds {
 
 struct Scenario {
   std::string file;
-  std::string text;                    // the YAML as read: recorded with logs, re-read for `localizer`
-  std::string world = "campus";        // a name under maps/ or a path
+  std::string text;              // the YAML as read: recorded with logs, re-read for `localizer`
+  std::string world = "campus";  // a name under maps/ or a path
   double duration_s = 60;
   uint64_t seed = 1;
   EgoSpec ego;
@@ -86,7 +86,7 @@ struct Scenario {
   std::string localizer_method = "proposed";
   bool closed_loop = false;
   PassThresholds pass;
-  int scan_every = 10;                 // simulate: write every Nth scan as PLY
+  int scan_every = 10;  // simulate: write every Nth scan as PLY
 
   int64_t duration_ns() const { return static_cast<int64_t>(duration_s * 1e9 + 0.5); }
 };

@@ -81,8 +81,7 @@ void Simulation::emit_scan(StreamSink& sink) {
     const size_t i = std::min(poses.size() - 2, size_t(std::max(0.0, std::floor(u))));
     const double f = std::clamp(u - double(i), 0.0, 1.0);
     const Pose2d &a = poses[i], &b = poses[i + 1];
-    return to_isometry({a.x + f * (b.x - a.x), a.y + f * (b.y - a.y),
-                        a.yaw + f * wrap_angle(b.yaw - a.yaw)});
+    return to_isometry({a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), a.yaw + f * wrap_angle(b.yaw - a.yaw)});
   };
   const PointCloud cloud =
       scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses_);

@@ -15,17 +15,17 @@
 namespace lidarloop {
 
 struct Wait {
-  double at = 0;          // arc length along the path, m
+  double at = 0;  // arc length along the path, m
   double duration_s = 0;
 };
 
 struct ActorPlan {
-  std::string name;       // for logs: "<type>_<index>"
+  std::string name;  // for logs: "<type>_<index>"
   ActorType type = ActorType::car;
-  Path path;              // a parked actor has a one-point path at its position
-  double start_s = 0;     // arc length where it stands at t = 0, m
-  double speed = 0;       // m/s; 0 = parked
-  int64_t depart_ns = 0;  // when it starts moving
+  Path path;                // a parked actor has a one-point path at its position
+  double start_s = 0;       // arc length where it stands at t = 0, m
+  double speed = 0;         // m/s; 0 = parked
+  int64_t depart_ns = 0;    // when it starts moving
   std::vector<Wait> waits;  // sorted by `at`
 };
 

@@ -32,13 +32,13 @@ static void add_prism(TriangleMesh& mesh, const std::vector<Eigen::Vector3f>& bo
     mesh.add_triangle(b0 + i, t0 + j, t0 + i, material);
   }
   for (uint32_t i = 1; i + 1 < n; ++i) {
-    mesh.add_triangle(t0, t0 + i, t0 + i + 1, material);     // top faces up
-    mesh.add_triangle(b0, b0 + i + 1, b0 + i, material);     // bottom faces down
+    mesh.add_triangle(t0, t0 + i, t0 + i + 1, material);  // top faces up
+    mesh.add_triangle(b0, b0 + i + 1, b0 + i, material);  // bottom faces down
   }
 }
 
-void add_box(TriangleMesh& mesh, const Eigen::Vector2f& centre, const Eigen::Vector2f& half_size, float yaw,
-             float z0, float z1, MaterialId material) {
+void add_box(TriangleMesh& mesh, const Eigen::Vector2f& centre, const Eigen::Vector2f& half_size, float yaw, float z0,
+             float z1, MaterialId material) {
   const Eigen::Rotation2D<float> rot(yaw);
   const Eigen::Vector2f corners[4] = {{-half_size.x(), -half_size.y()},
                                       {half_size.x(), -half_size.y()},
@@ -53,8 +53,8 @@ void add_box(TriangleMesh& mesh, const Eigen::Vector2f& centre, const Eigen::Vec
   add_prism(mesh, bottom, top, material);
 }
 
-void add_frustum(TriangleMesh& mesh, const Eigen::Vector3f& base, float radius_bottom, float radius_top,
-                 float height, int sides, MaterialId material) {
+void add_frustum(TriangleMesh& mesh, const Eigen::Vector3f& base, float radius_bottom, float radius_top, float height,
+                 int sides, MaterialId material) {
   std::vector<Eigen::Vector3f> bottom, top;
   for (int i = 0; i < sides; ++i) {
     const float a = 2.0f * float(M_PI) * float(i) / float(sides);

@@ -24,11 +24,11 @@ struct TriangleMesh {
 
 // Solid primitives used for buildings, poles, trees and markings.
 // A box given by its 8 corners' footprint (centre, half extents, yaw) between z0 and z1.
-void add_box(TriangleMesh& mesh, const Eigen::Vector2f& centre, const Eigen::Vector2f& half_size, float yaw,
-             float z0, float z1, MaterialId material);
+void add_box(TriangleMesh& mesh, const Eigen::Vector2f& centre, const Eigen::Vector2f& half_size, float yaw, float z0,
+             float z1, MaterialId material);
 // A vertical prism (cylinder or frustum) with `sides` faces.
-void add_frustum(TriangleMesh& mesh, const Eigen::Vector3f& base, float radius_bottom, float radius_top,
-                 float height, int sides, MaterialId material);
+void add_frustum(TriangleMesh& mesh, const Eigen::Vector3f& base, float radius_bottom, float radius_top, float height,
+                 int sides, MaterialId material);
 // A flat horizontal quad (e.g. paint) with corners counter-clockwise seen from above.
 void add_flat_quad(TriangleMesh& mesh, const std::array<Eigen::Vector2f, 4>& corners, float z, MaterialId material);
 

@@ -11,11 +11,11 @@ namespace lidarloop {
 
 namespace {
 
-constexpr double kTyresPerAxle = 2;        // Eq. 19's "2 C": the stiffness parameters are per tyre
-constexpr double kBlendWidth = 1.0;        // m/s: kinematic -> Eq. 19 over kinematic_below -+ half of this
-constexpr double kNegligibleWeight = 1e-6; // Eq. 19's weight below which its states are reset (see step())
-constexpr int64_t kMinStepNs = 10'000;     // 10 us
-constexpr int64_t kMaxStepNs = 1'000'000;  // 1 ms: Eq. 19 is stiff at low speed (time constants ~10 ms)
+constexpr double kTyresPerAxle = 2;         // Eq. 19's "2 C": the stiffness parameters are per tyre
+constexpr double kBlendWidth = 1.0;         // m/s: kinematic -> Eq. 19 over kinematic_below -+ half of this
+constexpr double kNegligibleWeight = 1e-6;  // Eq. 19's weight below which its states are reset (see step())
+constexpr int64_t kMinStepNs = 10'000;      // 10 us
+constexpr int64_t kMaxStepNs = 1'000'000;   // 1 ms: Eq. 19 is stiff at low speed (time constants ~10 ms)
 
 // How much of the motion comes from Eq. 19 (1) rather than the kinematic bicycle (0): linear in speed.
 double dynamic_weight(const VehicleParams& p, double vx) {
@@ -70,9 +70,7 @@ Continuous add_scaled(const Continuous& a, const Continuous& d, double h) {
 }
 
 // Exact decay factor of a first-order lag over dt; a zero time constant follows the command at once.
-double lag_factor(double dt, double time_constant) {
-  return time_constant > 0 ? std::exp(-dt / time_constant) : 0.0;
-}
+double lag_factor(double dt, double time_constant) { return time_constant > 0 ? std::exp(-dt / time_constant) : 0.0; }
 
 double understeer_gradient(const VehicleParams& p) {
   return p.mass / p.wheelbase() *
@@ -83,10 +81,10 @@ double understeer_gradient(const VehicleParams& p) {
 
 void read_vehicle_params(const YamlReader& y, const YAML::Node& n, VehicleParams& p) {
   y.expect_map(n, "vehicle");
-  y.allow_keys(n, {"cornering_stiffness_front", "cornering_stiffness_rear", "lf", "lr", "yaw_inertia", "mass",
-                   "steering_ratio", "wheel_radius", "track_width", "max_steer", "max_steer_rate",
-                   "steer_time_constant", "max_accel", "max_decel", "accel_time_constant", "max_speed",
-                   "kinematic_below", "step_ns"});
+  y.allow_keys(
+      n, {"cornering_stiffness_front", "cornering_stiffness_rear", "lf", "lr", "yaw_inertia", "mass", "steering_ratio",
+          "wheel_radius", "track_width", "max_steer", "max_steer_rate", "steer_time_constant", "max_accel", "max_decel",
+          "accel_time_constant", "max_speed", "kinematic_below", "step_ns"});
   // Ranges: what a road vehicle from a small car to a loaded truck can have.
   y.read_number(n, "cornering_stiffness_front", p.cornering_stiffness_front, 1e3, 1e6);
   y.read_number(n, "cornering_stiffness_rear", p.cornering_stiffness_rear, 1e3, 1e6);
@@ -97,7 +95,8 @@ void read_vehicle_params(const YamlReader& y, const YAML::Node& n, VehicleParams
   y.read_number(n, "steering_ratio", p.steering_ratio, 1.0, 50.0);
   y.read_number(n, "wheel_radius", p.wheel_radius, 0.1, 2.0);
   y.read_number(n, "track_width", p.track_width, 0.5, 4.0);
-  y.read_number(n, "max_steer", p.max_steer, 0.01, 1.2);  // below pi/2, where tan(delta) of the kinematic model blows up
+  y.read_number(n, "max_steer", p.max_steer, 0.01,
+                1.2);  // below pi/2, where tan(delta) of the kinematic model blows up
   y.read_number(n, "max_steer_rate", p.max_steer_rate, 0.01, 10.0);
   y.read_number(n, "steer_time_constant", p.steer_time_constant, 0.0, 2.0);
   y.read_number(n, "max_accel", p.max_accel, 0.1, 20.0);

@@ -23,18 +23,18 @@ struct VehicleParams {
   double yaw_inertia = 6000;                 // I_z, kg m^2
   double mass = 2300;                        // M, kg
   // Beyond the paper: what a real car's actuators and sensors need.
-  double steering_ratio = 16.0;              // steering-wheel angle / front-wheel angle
-  double wheel_radius = 0.33;                // m
-  double track_width = 1.6;                  // m, between left and right wheels
-  double max_steer = 0.55;                   // rad, front wheel
-  double max_steer_rate = 0.5;               // rad/s, front wheel
-  double steer_time_constant = 0.10;         // s, first-order lag of the steering actuator
-  double max_accel = 2.5;                    // m/s^2
-  double max_decel = 6.0;                    // m/s^2 (positive number)
-  double accel_time_constant = 0.25;         // s, first-order lag of drive and brakes
-  double max_speed = 25.0;                   // m/s
-  double kinematic_below = 1.5;              // m/s: kinematic model below, Eq. 19 above (blended over 1 m/s)
-  int64_t step_ns = 1'000'000;               // internal integration step (at most 1 ms)
+  double steering_ratio = 16.0;       // steering-wheel angle / front-wheel angle
+  double wheel_radius = 0.33;         // m
+  double track_width = 1.6;           // m, between left and right wheels
+  double max_steer = 0.55;            // rad, front wheel
+  double max_steer_rate = 0.5;        // rad/s, front wheel
+  double steer_time_constant = 0.10;  // s, first-order lag of the steering actuator
+  double max_accel = 2.5;             // m/s^2
+  double max_decel = 6.0;             // m/s^2 (positive number)
+  double accel_time_constant = 0.25;  // s, first-order lag of drive and brakes
+  double max_speed = 25.0;            // m/s
+  double kinematic_below = 1.5;       // m/s: kinematic model below, Eq. 19 above (blended over 1 m/s)
+  int64_t step_ns = 1'000'000;        // internal integration step (at most 1 ms)
 
   double wheelbase() const { return lf + lr; }
 };
@@ -44,13 +44,13 @@ void read_vehicle_params(const YamlReader& yaml, const YAML::Node& node, Vehicle
 VehicleParams load_vehicle_params(const std::string& path);  // e.g. assets/vehicle.yaml
 
 struct VehicleState {
-  double x = 0, y = 0;    // centre of mass, local frame, m
-  double yaw = 0;         // psi, rad
-  double vx = 0;          // longitudinal speed, m/s (never negative: no reversing)
-  double beta = 0;        // side-slip angle at the centre of mass, rad
-  double yaw_rate = 0;    // psi dot, rad/s
-  double steer = 0;       // front wheel angle delta_f actually reached by the actuator, rad
-  double accel = 0;       // longitudinal acceleration actually reached, m/s^2
+  double x = 0, y = 0;  // centre of mass, local frame, m
+  double yaw = 0;       // psi, rad
+  double vx = 0;        // longitudinal speed, m/s (never negative: no reversing)
+  double beta = 0;      // side-slip angle at the centre of mass, rad
+  double yaw_rate = 0;  // psi dot, rad/s
+  double steer = 0;     // front wheel angle delta_f actually reached by the actuator, rad
+  double accel = 0;     // longitudinal acceleration actually reached, m/s^2
 };
 
 struct VehicleCommand {

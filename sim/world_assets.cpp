@@ -22,8 +22,7 @@ std::string world_file(const std::string& name_or_path) {
     return name_or_path;
   }
   const std::string path = data_dir() + "/maps/" + name_or_path + "/world.yaml";
-  if (!fs::is_regular_file(path))
-    throw InputError("unknown world '" + name_or_path + "': " + path + " does not exist");
+  if (!fs::is_regular_file(path)) throw InputError("unknown world '" + name_or_path + "': " + path + " does not exist");
   return path;
 }
 

@@ -50,7 +50,10 @@ class RaisedLevel {
     std::vector<float> heights;
     size_t kdtree_get_point_count() const { return points.size(); }
     double kdtree_get_pt(size_t i, size_t dim) const { return points[i][int(dim)]; }
-    template <class BBox> bool kdtree_get_bbox(BBox&) const { return false; }
+    template <class BBox>
+    bool kdtree_get_bbox(BBox&) const {
+      return false;
+    }
   };
   using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Samples>, Samples, 2>;
   float constant_;
@@ -108,8 +111,8 @@ struct Builder {
     for (const auto& road : desc.roads) {
       strips.push_back(region::strip(road.centreline, road.width / 2, road.closed));
       road_union = region::unite(road_union, strips.back());
-      sidewalk_union = region::unite(
-          sidewalk_union, region::strip(road.centreline, road.width / 2 + road.sidewalk_width, road.closed));
+      sidewalk_union = region::unite(sidewalk_union,
+                                     region::strip(road.centreline, road.width / 2 + road.sidewalk_width, road.closed));
     }
     world.carriageway = region::closing(road_union, r);
     world.sidewalks = region::unite(region::closing(sidewalk_union, r),
@@ -147,9 +150,8 @@ struct Builder {
         region::subtract(region::offset(world.carriageway, g.curb_top_width), world.carriageway);
     const region::Paths sidewalk = region::subtract(
         world.sidewalks, region::unite(world.carriageway, region::offset(world.carriageway, g.curb_top_width)));
-    const region::Paths verge =
-        region::subtract(region::rectangle(box.center(), {1, 0}, box.sizes().x() / 2, box.sizes().y() / 2),
-                         world.sidewalks);
+    const region::Paths verge = region::subtract(
+        region::rectangle(box.center(), {1, 0}, box.sizes().x() / 2, box.sizes().y() / 2), world.sidewalks);
     auto flat = [](const Eigen::Vector2d&) { return 0.0f; };
     region::mesh_region(world.carriageway, kGroundTile, flat, mat("asphalt"), world.mesh);
     region::mesh_region(curb_tops, kGroundTile, world.raised_level, mat("curb_concrete"), world.mesh);
@@ -163,11 +165,10 @@ struct Builder {
       for (size_t i = 1; i < ring.size(); ++i) {
         const Eigen::Vector2f a = ring[i - 1].cast<float>(), b = ring[i].cast<float>();
         const auto base = static_cast<uint32_t>(world.mesh.vertices.size());
-        world.mesh.vertices.insert(world.mesh.vertices.end(),
-                                   {{a.x(), a.y(), 0.0f},
-                                    {b.x(), b.y(), 0.0f},
-                                    {b.x(), b.y(), world.raised_level(ring[i])},
-                                    {a.x(), a.y(), world.raised_level(ring[i - 1])}});
+        world.mesh.vertices.insert(world.mesh.vertices.end(), {{a.x(), a.y(), 0.0f},
+                                                               {b.x(), b.y(), 0.0f},
+                                                               {b.x(), b.y(), world.raised_level(ring[i])},
+                                                               {a.x(), a.y(), world.raised_level(ring[i - 1])}});
         world.mesh.add_triangle(base + 1, base, base + 3, curb);
         world.mesh.add_triangle(base + 1, base + 3, base + 2, curb);
       }
@@ -181,8 +182,8 @@ struct Builder {
       const RoadSpec& road = *desc.road(c.road);
       const PolylineSample s = sample_polyline(road.centreline, c.at);
       const Eigen::Vector2d n = left_normal(s.tangent);
-      no_lane_paint = region::unite(no_lane_paint, region::rectangle(s.point, s.tangent, c.width / 2 + kCrosswalkPad,
-                                                                     road.width));
+      no_lane_paint =
+          region::unite(no_lane_paint, region::rectangle(s.point, s.tangent, c.width / 2 + kCrosswalkPad, road.width));
       const double period = g.crosswalk_stripe + g.crosswalk_gap;
       const int stripes = static_cast<int>((road.width - 2 * g.crosswalk_gap) / period);
       for (int k = 0; k < stripes; ++k) {
@@ -190,9 +191,9 @@ struct Builder {
         const Eigen::Vector2d centre = s.point + n * lateral;
         const Polyline2d rect =
             region::to_polyline(region::rectangle(centre, s.tangent, c.width / 2, g.crosswalk_stripe / 2)[0], false);
-        add_flat_quad(world.mesh, {rect[0].cast<float>(), rect[1].cast<float>(), rect[2].cast<float>(),
-                                   rect[3].cast<float>()},
-                      z, zebra);
+        add_flat_quad(world.mesh,
+                      {rect[0].cast<float>(), rect[1].cast<float>(), rect[2].cast<float>(), rect[3].cast<float>()}, z,
+                      zebra);
       }
     }
     for (const auto& sl : desc.stop_lines) {
@@ -208,7 +209,8 @@ struct Builder {
       auto& dividers = road.marking == MarkingStyle::solid ? solid : dashed;
       if (road.marking != MarkingStyle::none)
         for (int k = 1; k < road.lanes; ++k)
-          dividers.push_back(offset_polyline(road.centreline, -road.width / 2 + k * road.width / road.lanes, road.closed));
+          dividers.push_back(
+              offset_polyline(road.centreline, -road.width / 2 + k * road.width / road.lanes, road.closed));
       if (road.edge_lines)
         for (double side : {-1.0, 1.0})
           solid.push_back(offset_polyline(road.centreline, side * (road.width / 2 - g.edge_line_inset), road.closed));
@@ -271,8 +273,7 @@ struct Builder {
     }
     std::map<std::string, TriangleMesh> meshes;
     for (const auto& v : desc.parked) {
-      if (!meshes.count(v.type))
-        meshes[v.type] = load_actor_mesh(actors_dir, *actor_type_from_name(v.type), materials);
+      if (!meshes.count(v.type)) meshes[v.type] = load_actor_mesh(actors_dir, *actor_type_from_name(v.type), materials);
       const TriangleMesh& mesh = meshes[v.type];
       Eigen::AlignedBox3f box;
       for (const auto& p : mesh.vertices) box.extend(p);

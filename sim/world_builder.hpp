@@ -20,9 +20,9 @@ struct World {
   std::string name;
   Geodetic origin;
   TriangleMesh mesh;
-  std::vector<Polyline2d> curbs;   // closed rings along the carriageway's edge (first point repeated)
-  region::Paths carriageway;       // area between the curbs
-  region::Paths sidewalks;         // carriageway + curbs + sidewalks
+  std::vector<Polyline2d> curbs;  // closed rings along the carriageway's edge (first point repeated)
+  region::Paths carriageway;      // area between the curbs
+  region::Paths sidewalks;        // carriageway + curbs + sidewalks
   Eigen::AlignedBox2d bounds;
   std::function<float(const Eigen::Vector2d&)> raised_level;  // sidewalk height at a point
 

@@ -39,11 +39,10 @@ void read_road_properties(const YamlReader& y, const YAML::Node& n, RoadSpec& ro
   if (n["edge_lines"]) road.edge_lines = y.boolean(n["edge_lines"], "edge_lines");
   if (n["curb_height"]) road.curb_height = y.number_in(n["curb_height"], "curb_height", 0.05, 0.30);
   if (n["sidewalk_width"]) road.sidewalk_width = y.number_in(n["sidewalk_width"], "sidewalk_width", 0.0, 15.0);
-  if (n["smoothing_radius"])
-    road.smoothing_radius = y.number_in(n["smoothing_radius"], "smoothing_radius", 0.0, 500.0);
+  if (n["smoothing_radius"]) road.smoothing_radius = y.number_in(n["smoothing_radius"], "smoothing_radius", 0.0, 500.0);
 }
-#define ROAD_PROPERTY_KEYS "width", "lanes", "one_way", "marking", "edge_lines", "curb_height", \
-                           "sidewalk_width", "smoothing_radius"
+#define ROAD_PROPERTY_KEYS \
+  "width", "lanes", "one_way", "marking", "edge_lines", "curb_height", "sidewalk_width", "smoothing_radius"
 
 RoadSpec read_road(const YamlReader& y, const YAML::Node& n, const RoadSpec& defaults) {
   y.expect_map(n, "a road");
@@ -64,8 +63,8 @@ RoadSpec read_road(const YamlReader& y, const YAML::Node& n, const RoadSpec& def
       y.fail(points[i % points.size()], "road '" + road.name + "' has a zero-length segment between points " +
                                             std::to_string(i - 1) + " and " + std::to_string(i % points.size()));
   if (auto hit = find_self_intersection(road.points, road.closed))
-    y.fail(points, "road '" + road.name + "' intersects itself (segments " + std::to_string(hit->first) +
-                       " and " + std::to_string(hit->second) + ")");
+    y.fail(points, "road '" + road.name + "' intersects itself (segments " + std::to_string(hit->first) + " and " +
+                       std::to_string(hit->second) + ")");
   for (size_t i = 1; i + 1 < road.points.size(); ++i) {
     const Eigen::Vector2d a = road.points[i] - road.points[i - 1], b = road.points[i + 1] - road.points[i];
     if (a.dot(b) < std::cos(kMaxTurn) * a.norm() * b.norm())
@@ -115,11 +114,13 @@ void check_references(const YamlReader& y, const YAML::Node& root, WorldDescript
     const YAML::Node entry = root[key][i];
     if (!r) y.fail(entry["road"], std::string(key) + " refers to unknown road '" + road + "'");
     if (has_at && at > polyline_length(r->centreline))
-      y.fail(entry["at"] ? entry["at"] : entry, "at = " + std::to_string(at) + " m is beyond the end of road '" + road + "' (" +
-                              std::to_string(polyline_length(r->centreline)) + " m)");
+      y.fail(entry["at"] ? entry["at"] : entry, "at = " + std::to_string(at) + " m is beyond the end of road '" + road +
+                                                    "' (" + std::to_string(polyline_length(r->centreline)) + " m)");
   };
-  for (size_t i = 0; i < w.crosswalks.size(); ++i) check("crosswalks", i, w.crosswalks[i].road, w.crosswalks[i].at, true);
-  for (size_t i = 0; i < w.stop_lines.size(); ++i) check("stop_lines", i, w.stop_lines[i].road, w.stop_lines[i].at, true);
+  for (size_t i = 0; i < w.crosswalks.size(); ++i)
+    check("crosswalks", i, w.crosswalks[i].road, w.crosswalks[i].at, true);
+  for (size_t i = 0; i < w.stop_lines.size(); ++i)
+    check("stop_lines", i, w.stop_lines[i].road, w.stop_lines[i].at, true);
   for (size_t i = 0; i < w.poles.size(); ++i) check("poles", i, w.poles[i].road, 0, false);
   for (size_t i = 0; i < w.trees.size(); ++i) check("trees", i, w.trees[i].road, 0, false);
 }
@@ -127,8 +128,8 @@ void check_references(const YamlReader& y, const YAML::Node& root, WorldDescript
 WorldDescription parse(const YamlReader& y) {
   const YAML::Node& root = y.root();
   y.expect_map(root, "a world description");
-  y.allow_keys(root, {"name", "origin", "road_defaults", "geometry", "roads", "crosswalks", "stop_lines",
-                      "buildings", "poles", "trees", "parked_vehicles"});
+  y.allow_keys(root, {"name", "origin", "road_defaults", "geometry", "roads", "crosswalks", "stop_lines", "buildings",
+                      "poles", "trees", "parked_vehicles"});
   WorldDescription w;
   w.file = y.file();
   w.name = y.string(y.required(root, "name"), "name");

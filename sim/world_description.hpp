@@ -16,11 +16,11 @@ enum class RoadSide { left, right, both };  // relative to the centreline's dire
 
 struct RoadSpec {
   std::string name;
-  std::string where;            // file:line:col of the road's entry, for later errors
-  Polyline2d points;            // as written
-  Polyline2d centreline;        // after corner smoothing; closed lines repeat their first point
-  bool closed = false;          // a loop: the last point joins the first
-  double width = 7.0;           // carriageway, curb face to curb face
+  std::string where;      // file:line:col of the road's entry, for later errors
+  Polyline2d points;      // as written
+  Polyline2d centreline;  // after corner smoothing; closed lines repeat their first point
+  bool closed = false;    // a loop: the last point joins the first
+  double width = 7.0;     // carriageway, curb face to curb face
   int lanes = 2;
   bool one_way = false;
   MarkingStyle marking = MarkingStyle::dashed;  // lane dividers
@@ -71,15 +71,15 @@ struct ParkedVehicleSpec {
 };
 
 struct WorldGeometryParams {
-  double corner_radius = 8.0;      // curb corner radius where roads meet
-  double curb_top_width = 0.15;    // width of the curb stone's top face
+  double corner_radius = 8.0;    // curb corner radius where roads meet
+  double curb_top_width = 0.15;  // width of the curb stone's top face
   double paint_width = 0.15;
-  double paint_height = 0.003;     // paint stands this far above the asphalt
+  double paint_height = 0.003;  // paint stands this far above the asphalt
   double dash_length = 3.0, dash_gap = 6.0;
-  double edge_line_inset = 0.3;    // edge line centre from the curb
+  double edge_line_inset = 0.3;  // edge line centre from the curb
   double stop_line_width = 0.4;
   double crosswalk_stripe = 0.45, crosswalk_gap = 0.6;
-  double margin = 30.0;            // ground beyond the outermost object
+  double margin = 30.0;  // ground beyond the outermost object
 };
 
 struct WorldDescription {

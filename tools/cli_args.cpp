@@ -99,9 +99,9 @@ Args parse_args(const CommandSpec& spec, const std::vector<std::string>& argv) {
   const int n = int(args.positional_.size());
   if (n < spec.min_positional || n > spec.max_positional)
     throw InputError("lidarloop " + spec.name + ": expected " +
-                     (spec.min_positional == spec.max_positional ? std::to_string(spec.min_positional)
-                                                                 : std::to_string(spec.min_positional) + " to " +
-                                                                       std::to_string(spec.max_positional)) +
+                     (spec.min_positional == spec.max_positional
+                          ? std::to_string(spec.min_positional)
+                          : std::to_string(spec.min_positional) + " to " + std::to_string(spec.max_positional)) +
                      " positional argument(s), got " + std::to_string(n) + " (usage: " + spec.usage + ")");
   return args;
 }
@@ -112,8 +112,10 @@ std::string help(const CommandSpec& spec) {
   if (!spec.options.empty()) out << "\noptions:\n";
   for (const auto& o : spec.options) {
     std::string left = "  --" + o.name + (o.value_name.empty() ? "" : " " + o.value_name);
-    if (left.size() < 30) left.resize(30, ' ');
-    else left += "  ";
+    if (left.size() < 30)
+      left.resize(30, ' ');
+    else
+      left += "  ";
     out << left << o.help << "\n";
   }
   out << "  --help                      show this help\n";

@@ -11,8 +11,8 @@
 namespace lidarloop {
 
 struct OptionSpec {
-  std::string name;         // without the leading dashes
-  std::string value_name;   // empty for a flag that takes no value
+  std::string name;        // without the leading dashes
+  std::string value_name;  // empty for a flag that takes no value
   std::string help;
 };
 

@@ -5,9 +5,9 @@
 #include <iostream>
 #include <limits>
 
-#include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <nlohmann/json.hpp>
 
 #include "tools/commands.hpp"
 #include "tools/scene_setup.hpp"
@@ -88,21 +88,20 @@ static int bench_lidar(const Args& args) {
   }
   const double ours = median(ours_ms), bare = median(bare_ms);
   const double realtime = double(config.scan_period_ns()) * 1e-6 / ours;
-  const nlohmann::json result = {
-      {"bench", "lidar"},
-      {"world", s.world.world.name},
-      {"world_triangles", s.scene->world_triangles()},
-      {"actors", actors.size()},
-      {"threads", threads},
-      {"scans", scans},
-      {"rays_per_scan", scanner.rays_per_scan()},
-      {"points_per_scan", points / scans},
-      {"ms_per_scan", ours},
-      {"bare_embree_ms_per_scan", bare},
-      {"ratio", ours / bare},
-      {"rays_per_s", double(scanner.rays_per_scan()) / ours * 1e3},
-      {"realtime_factor", realtime},
-      {"realtime_factor_per_core", realtime / threads}};
+  const nlohmann::json result = {{"bench", "lidar"},
+                                 {"world", s.world.world.name},
+                                 {"world_triangles", s.scene->world_triangles()},
+                                 {"actors", actors.size()},
+                                 {"threads", threads},
+                                 {"scans", scans},
+                                 {"rays_per_scan", scanner.rays_per_scan()},
+                                 {"points_per_scan", points / scans},
+                                 {"ms_per_scan", ours},
+                                 {"bare_embree_ms_per_scan", bare},
+                                 {"ratio", ours / bare},
+                                 {"rays_per_s", double(scanner.rays_per_scan()) / ours * 1e3},
+                                 {"realtime_factor", realtime},
+                                 {"realtime_factor_per_core", realtime / threads}};
   std::cout << result.dump(2) << "\n";
   return 0;
 }
@@ -133,7 +132,8 @@ Command bench_command() {
             {"scenario", "FILE", "localizer, loop: the drive (default scenarios/campus_traffic.yaml)"},
             {"duration", "S", "localizer, loop: seconds of it (default 20)"},
             {"method", "NAME", "localizer, loop: the method (default: the scenario's)"}},
-           1, 1},
+           1,
+           1},
           run_bench};
 }
 

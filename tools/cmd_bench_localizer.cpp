@@ -10,11 +10,11 @@
 #include <nlohmann/json.hpp>
 
 #include "common/input_error.hpp"
-#include "tools/commands.hpp"
 #include "loop/localizer_loop.hpp"
 #include "loop/localizer_setup.hpp"
-#include "tools/scene_setup.hpp"
 #include "loop/scorer.hpp"
+#include "tools/commands.hpp"
+#include "tools/scene_setup.hpp"
 
 namespace lidarloop {
 namespace {
@@ -37,7 +37,8 @@ class MemorySink : public StreamSink {
 constexpr int kWarmupScans = 10;  // the accumulator fills and the first map tiles load
 
 nlohmann::json percentiles(const std::vector<double>& ms) {
-  return {{"p50", percentile_nearest_rank(ms, 50)}, {"p99", percentile_nearest_rank(ms, 99)},
+  return {{"p50", percentile_nearest_rank(ms, 50)},
+          {"p99", percentile_nearest_rank(ms, 99)},
           {"max", percentile_nearest_rank(ms, 100)}};
 }
 
@@ -60,8 +61,11 @@ nlohmann::json replay(const std::vector<Message>& messages, HdMap& map, const Lo
   }
   nlohmann::json stages;
   for (int k = 0; k < kStageCount; ++k) stages[stage_name(Stage(k))] = percentiles(stage[size_t(k)]);
-  return {{"threads", threads}, {"scans_timed", total.size()}, {"scans_degraded", degraded},
-          {"total_ms", percentiles(total)}, {"stages_ms", stages}};
+  return {{"threads", threads},
+          {"scans_timed", total.size()},
+          {"scans_degraded", degraded},
+          {"total_ms", percentiles(total)},
+          {"stages_ms", stages}};
 }
 
 std::string default_scenario() { return data_dir() + "/scenarios/campus_traffic.yaml"; }
@@ -112,13 +116,10 @@ int bench_loop(const Args& args) {
                     {"localizer_busy_share", r.localizer_wall_s / r.wall_s},
                     {"scans", r.scans}});
   }
-  const nlohmann::json result = {{"benchmark", "loop"},
-                                 {"scenario", s.scenario.file},
-                                 {"method", method_name(params.method)},
-                                 {"threads", threads},
-                                 {"simulated_s", s.scenario.duration_s},
-                                 {"budget_realtime_factor", 10.0},
-                                 {"runs", runs}};
+  const nlohmann::json result = {
+      {"benchmark", "loop"}, {"scenario", s.scenario.file},          {"method", method_name(params.method)},
+      {"threads", threads},  {"simulated_s", s.scenario.duration_s}, {"budget_realtime_factor", 10.0},
+      {"runs", runs}};
   std::cout << result.dump(2) << "\n";
   return 0;
 }

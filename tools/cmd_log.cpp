@@ -5,10 +5,10 @@
 #include <map>
 
 #include "common/input_error.hpp"
-#include "tools/commands.hpp"
 #include "logs/log_export.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/mcap/mcap_recover.hpp"
+#include "tools/commands.hpp"
 
 namespace lidarloop {
 
@@ -145,11 +145,11 @@ int run_recover(const Args& args) {
   const McapRecoverReport r = recover_mcap(in, out);
   std::cout << "recovered    " << r.messages << " messages in " << r.chunks << " chunks, " << r.attachments
             << " attachments, " << r.metadata << " metadata records\n"
-            << "input        " << in << " (" << r.input_bytes << " bytes): "
-            << (r.complete ? "complete" : "incomplete (no Data End record)") << "\n";
+            << "input        " << in << " (" << r.input_bytes
+            << " bytes): " << (r.complete ? "complete" : "incomplete (no Data End record)") << "\n";
   if (r.skipped_chunks || r.skipped_bytes || r.orphan_messages)
-    std::cout << "lost         " << r.skipped_chunks << " corrupt chunks, " << r.skipped_bytes
-              << " unreadable bytes, " << r.orphan_messages << " messages on undefined channels\n";
+    std::cout << "lost         " << r.skipped_chunks << " corrupt chunks, " << r.skipped_bytes << " unreadable bytes, "
+              << r.orphan_messages << " messages on undefined channels\n";
   for (const auto& p : r.problems) std::cout << "  " << p << "\n";
   std::cout << "output       " << out << "\n";
   return 0;
@@ -179,32 +179,38 @@ int run_export(const Args& args) {
 }  // namespace
 
 Command info_command() {
-  return {{"info", "lidarloop info FILE.mcap [--quick]",
+  return {{"info",
+           "lidarloop info FILE.mcap [--quick]",
            "Show an MCAP log's topics, message types, counts, rates, time range, chunks and compression,\n"
            "attachments and metadata, after checking every CRC in the file.",
            {{"quick", "", "read only the summary section (no integrity check)"}},
-           1, 1},
+           1,
+           1},
           run_info};
 }
 
 Command recover_command() {
-  return {{"recover", "lidarloop recover BROKEN.mcap FIXED.mcap",
+  return {{"recover",
+           "lidarloop recover BROKEN.mcap FIXED.mcap",
            "Rebuild a damaged MCAP log (cut off by a crash, truncated, corrupted): every intact chunk's\n"
            "messages, the attachments and metadata go into a new, complete, indexed file.",
            {},
-           2, 2},
+           2,
+           2},
           run_recover};
 }
 
 Command export_command() {
-  return {{"export", "lidarloop export FILE.mcap (--tum FILE | --pcd DIR | --kitti DIR) [--topic TOPIC]",
+  return {{"export",
+           "lidarloop export FILE.mcap (--tum FILE | --pcd DIR | --kitti DIR) [--topic TOPIC]",
            "Convert a log: a trajectory to TUM (for evo), scans to PCD files, or scans and RTK fixes to\n"
            "the KITTI raw-data layout.",
            {{"tum", "FILE", "write a nav_msgs/Odometry topic as TUM (default: the estimate, else the truth)"},
             {"pcd", "DIR", "write each scan as a binary PCD file"},
             {"kitti", "DIR", "write the KITTI raw layout (velodyne_points, oxts, calib_imu_to_velo.txt)"},
             {"topic", "TOPIC", "the topic to export (default /localizer/odometry or /truth/odometry; /lidar/points)"}},
-           1, 1},
+           1,
+           1},
           run_export};
 }
 

@@ -1,18 +1,18 @@
 // lidarloop map: build (or find) a world's HD map; the `bench map` memory benchmark lives here too.
+#include <sys/resource.h>
 #include <chrono>
 #include <iostream>
-#include <sys/resource.h>
 
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
 
 #include "localizer/hd_map.hpp"
-#include "sim/path.hpp"
-#include "tools/commands.hpp"
 #include "loop/map_cache.hpp"
-#include "tools/scene_setup.hpp"
+#include "sim/path.hpp"
 #include "sim/world_assets.hpp"
+#include "tools/commands.hpp"
+#include "tools/scene_setup.hpp"
 
 namespace lidarloop {
 
@@ -60,7 +60,7 @@ int bench_map(const Args& args) {
   const CurbLayer& curbs = hd.curbs;
   IntensityMap& map = hd.intensity;
   const double step = args.number("step", 12.0);  // m between queries: 1 s at 12 m/s
-  constexpr double kGridHalf = 20.0;               // grid S: 200 x 200 cells of 0.2 m
+  constexpr double kGridHalf = 20.0;              // grid S: 200 x 200 cells of 0.2 m
   size_t windows = 0, cells = 0, curb_points = 0;
   for (const auto& road : w.description.roads) {
     const Path path = lane_path(road, Lane::right, false);
@@ -93,7 +93,8 @@ int bench_map(const Args& args) {
 }  // namespace
 
 Command map_command() {
-  return {{"map", "lidarloop map WORLD [--traffic] [--force] [--resolution M] [--speed V]",
+  return {{"map",
+           "lidarloop map WORLD [--traffic] [--force] [--resolution M] [--speed V]",
            "Build a world's HD map by a mapping drive over every lane (or find it in the cache): the curb\n"
            "layer (GeoJSON) and the intensity layer (tiles of per-cell count, mean and variance, Eq. 8).",
            {{"traffic", "", "oncoming traffic during the drive (raises the variance of the cells it crosses)"},
@@ -101,7 +102,8 @@ Command map_command() {
             {"resolution", "M", "intensity cell size (default 0.2 m)"},
             {"speed", "M_S", "mapping drive speed (default 12 m/s)"},
             {"threads", "N", "worker threads (default: all cores)"}},
-           1, 1},
+           1,
+           1},
           run_map};
 }
 

@@ -8,14 +8,14 @@
 
 #include "common/input_error.hpp"
 #include "localizer/localizer.hpp"
-#include "tools/commands.hpp"
-#include "loop/localizer_setup.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/ros2_messages.hpp"
+#include "loop/localizer_setup.hpp"
 #include "loop/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "loop/run_recording.hpp"
+#include "tools/commands.hpp"
 
 namespace lidarloop {
 namespace {
@@ -101,28 +101,31 @@ int run_replay(const Args& args) {
 
   const std::string name = std::filesystem::path(run.scenario_name).stem().string();
   const std::string out = args.text("out", "out/" + name + "-replay");
-  const ScoredRun scored =
-      score_and_write(out, name, scenario, resolved.ego_route, truth, method_name(params.method), estimates, nullptr, map);
+  const ScoredRun scored = score_and_write(out, name, scenario, resolved.ego_route, truth, method_name(params.method),
+                                           estimates, nullptr, map);
   std::cout << comparison_markdown({scored.metrics});
   std::printf("\nlog        %s (%zu scans, seed %llu, recorded with %s)\n", log.c_str(), scans,
               (unsigned long long)scenario.seed, recorded_method.empty() ? "no localizer" : recorded_method.c_str());
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
-  std::printf("result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
-              "trajectory.png)\n",
-              scored.metrics.pass ? "PASS" : "FAIL", out.c_str());
+  std::printf(
+      "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
+      "trajectory.png)\n",
+      scored.metrics.pass ? "PASS" : "FAIL", out.c_str());
   return scored.metrics.pass ? 0 : 1;
 }
 
 }  // namespace
 
 Command replay_command() {
-  return {{"replay", "lidarloop replay FILE.mcap [--method NAME] [--out DIR]",
+  return {{"replay",
+           "lidarloop replay FILE.mcap [--method NAME] [--out DIR]",
            "Feed a log recorded by `run --record` or `simulate --record` to the localizer and score it\n"
            "against the recorded ground truth, with the recorded scenario's thresholds. With the recorded\n"
            "method, the estimates are the live run's, bit for bit. Exit codes as for run.",
            {{"method", "NAME", "localizer method (default: the recorded one, else the scenario's)"},
             {"out", "DIR", "output folder (default out/<scenario name>-replay)"}},
-           1, 1},
+           1,
+           1},
           run_replay};
 }
 

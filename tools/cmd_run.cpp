@@ -1,20 +1,20 @@
 // lidarloop run / compare: a scenario with the localizer in the loop, scored against ground truth.
+#include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
-#include <memory>
 #include <iostream>
+#include <memory>
 #include <sstream>
-#include <unistd.h>
 
 #include "common/input_error.hpp"
-#include "tools/commands.hpp"
 #include "loop/localizer_loop.hpp"
 #include "loop/localizer_setup.hpp"
 #include "loop/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "loop/run_recording.hpp"
+#include "tools/commands.hpp"
 #include "tools/scene_setup.hpp"
 
 namespace lidarloop {
@@ -46,7 +46,6 @@ struct Progress {
     if (terminal) std::printf("\r%70s\r", "");
   }
 };
-
 
 int run_run(const Args& args) {
   const int threads = thread_count(args);
@@ -92,9 +91,10 @@ int run_run(const Args& args) {
   std::printf("obstacles  in the corridor in %zu of %zu scans (%.0f%%)\n", with_obstacles, trace.estimates.size(),
               100.0 * double(with_obstacles) / double(std::max<size_t>(trace.estimates.size(), 1)));
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
-  std::printf("result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
-              "trajectory.png, worst_frame.png)\n",
-              scored.metrics.pass ? "PASS" : "FAIL", out.c_str());
+  std::printf(
+      "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
+      "trajectory.png, worst_frame.png)\n",
+      scored.metrics.pass ? "PASS" : "FAIL", out.c_str());
   return scored.metrics.pass ? 0 : 1;
 }
 
@@ -128,8 +128,8 @@ int expect_best(const std::vector<Metrics>& metrics, const std::string& method) 
         best = false;
       }
   }
-  std::printf("result     %s %s\n", method.c_str(), best ? "is at least as good as every other method on each RMSE"
-                                                         : "is not the best on every RMSE");
+  std::printf("result     %s %s\n", method.c_str(),
+              best ? "is at least as good as every other method on each RMSE" : "is not the best on every RMSE");
   return best ? 0 : 1;
 }
 
@@ -138,7 +138,8 @@ int run_compare(const Args& args) {
   const auto limit = limit_threads(threads);
   LoadedScenario s = load_with_overrides(args);
   std::vector<LocalizerParams> params;
-  for (const auto& m : parse_methods(args.text("methods", "all"))) params.push_back(localizer_params_for(s.scenario, m));
+  for (const auto& m : parse_methods(args.text("methods", "all")))
+    params.push_back(localizer_params_for(s.scenario, m));
   const std::string name = std::filesystem::path(s.scenario.file).stem().string();
   const std::string out = args.text("out", "out/" + name + "-compare");
   std::filesystem::create_directories(out);
@@ -165,8 +166,9 @@ int run_compare(const Args& args) {
     throw InputError(out + "/comparison.md: cannot write file");
   }
   std::cout << table;
-  std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n", s.scenario.file.c_str(),
-              (unsigned long long)s.scenario.seed, s.scenario.duration_s, r.scans, metrics.size());
+  std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n",
+              s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.duration_s, r.scans,
+              metrics.size());
   std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, <method>/...)\n", out.c_str());
   if (const auto best = args.value("expect-best")) return expect_best(metrics, *best);
   return 0;
@@ -175,8 +177,9 @@ int run_compare(const Args& args) {
 }  // namespace
 
 Command run_command() {
-  return {{"run", "lidarloop run SCENARIO.yaml [--method NAME] [--loop open|closed] [--out DIR] [--seed N]\n"
-                  "                    [--record FILE.mcap]",
+  return {{"run",
+           "lidarloop run SCENARIO.yaml [--method NAME] [--loop open|closed] [--out DIR] [--seed N]\n"
+           "                    [--record FILE.mcap]",
            "Run a scenario with the localizer in the loop and score it against ground truth. Writes\n"
            "metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and plots to DIR. Exit 0 when\n"
            "every threshold of the scenario's `pass` holds, 1 when one fails, 2 on bad input.",
@@ -187,12 +190,14 @@ Command run_command() {
             {"duration", "S", "override the scenario's duration, seconds"},
             {"record", "FILE.mcap", "record every stream and the estimates as an MCAP log (replay redoes the run)"},
             {"threads", "N", "worker threads (default: all cores)"}},
-           1, 1},
+           1,
+           1},
           run_run};
 }
 
 Command compare_command() {
-  return {{"compare", "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--expect-best NAME] [--out DIR] [--seed N]",
+  return {{"compare",
+           "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--expect-best NAME] [--out DIR] [--seed N]",
            "Simulate a scenario once and feed the identical streams to several localizer methods; print\n"
            "and write a table like the paper's Table III (comparison.md, comparison.csv).",
            {{"methods", "LIST", "all, or a comma-separated list of methods (default all)"},
@@ -201,7 +206,8 @@ Command compare_command() {
             {"seed", "N", "override the scenario's seed"},
             {"duration", "S", "override the scenario's duration, seconds"},
             {"threads", "N", "worker threads (default: all cores)"}},
-           1, 1},
+           1,
+           1},
           run_compare};
 }
 

@@ -12,7 +12,6 @@
 
 namespace lidarloop {
 
-
 int thread_count(const Args& args) {
   const long n = args.integer("threads", 0, 0, 1024);
   return n > 0 ? int(n) : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -85,7 +84,8 @@ Command scan_command() {
             {"out", "FILE.ply", "write the point cloud (sensor frame)"},
             {"png", "FILE.png", "write a bird's-eye picture with the curb map"},
             {"png-range", "M", "the picture covers +-M metres around the sensor (default 50)"}},
-           0, 0},
+           0,
+           0},
           run_scan};
 }
 

@@ -1,15 +1,15 @@
 // lidarloop validate / simulate: check a scenario, or run it without a localizer and write its streams.
+#include <unistd.h>
 #include <chrono>
-#include <filesystem>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <unistd.h>
 
-#include "tools/commands.hpp"
-#include "tools/csv_streams.hpp"
 #include "loop/localizer_setup.hpp"
 #include "loop/run_recording.hpp"
+#include "tools/commands.hpp"
+#include "tools/csv_streams.hpp"
 #include "tools/scene_setup.hpp"
 #include "tools/world_map_png.hpp"
 
@@ -69,14 +69,18 @@ int run_simulate(const Args& args) {
 }  // namespace
 
 Command validate_command() {
-  return {{"validate", "lidarloop validate SCENARIO.yaml [SCENARIO.yaml ...]",
-           "Check scenarios without running them: syntax, keys, values, and paths on the world's roads.", {}, 1,
+  return {{"validate",
+           "lidarloop validate SCENARIO.yaml [SCENARIO.yaml ...]",
+           "Check scenarios without running them: syntax, keys, values, and paths on the world's roads.",
+           {},
+           1,
            1000},
           run_validate};
 }
 
 Command simulate_command() {
-  return {{"simulate", "lidarloop simulate SCENARIO.yaml [--out DIR] [--seed N] [--duration S] [--scan-every N]\n"
+  return {{"simulate",
+           "lidarloop simulate SCENARIO.yaml [--out DIR] [--seed N] [--duration S] [--scan-every N]\n"
            "                         [--record FILE.mcap]",
            "Run a scenario's world, ego, traffic and sensors without a localizer; write the streams as CSV,\n"
            "every Nth scan as PLY, and a top view of roads, actors and the ego's path.",
@@ -86,7 +90,8 @@ Command simulate_command() {
             {"scan-every", "N", "write every Nth scan as PLY (0: none; default from the scenario, 10)"},
             {"record", "FILE.mcap", "also record every stream as an MCAP log"},
             {"threads", "N", "worker threads (default: all cores)"}},
-           1, 1},
+           1,
+           1},
           run_simulate};
 }
 

@@ -3,8 +3,8 @@
 #include <iostream>
 
 #include "sim/obj_file.hpp"
-#include "tools/commands.hpp"
 #include "sim/world_assets.hpp"
+#include "tools/commands.hpp"
 #include "tools/world_map_png.hpp"
 
 namespace lidarloop {
@@ -49,7 +49,8 @@ Command world_command() {
             {"curbs", "FILE", "write the curb map as GeoJSON LineStrings in WGS-84"},
             {"png", "FILE", "write a top view coloured by material, curbs in green"},
             {"resolution", "M", "metres per pixel of the top view (default 0.25)"}},
-           1, 1},
+           1,
+           1},
           run_world};
 }
 

@@ -14,8 +14,10 @@ CsvStreams::CsvStreams(const std::string& dir, const LocalFrame& frame, int scan
   if (ec) throw InputError(dir + ": cannot create output folder (" + ec.message() + ")");
   truth_ = open("truth.csv", "stamp_ns,x_m,y_m,yaw_rad,speed_mps,yaw_rate_radps,steer_rad,cross_track_m");
   can_ = open("can.csv", "stamp_ns,wheel_fl_mps,wheel_fr_mps,wheel_rl_mps,wheel_rr_mps,steering_wheel_rad");
-  gps_ = open("gps.csv", "stamp_ns,status,lat_deg,lon_deg,alt_m,heading_rad,var_east_m2,var_north_m2,var_heading_rad2,x_m,y_m");
-  rtk_ = open("rtk.csv", "stamp_ns,status,lat_deg,lon_deg,alt_m,heading_rad,var_east_m2,var_north_m2,var_heading_rad2,x_m,y_m");
+  gps_ = open("gps.csv",
+              "stamp_ns,status,lat_deg,lon_deg,alt_m,heading_rad,var_east_m2,var_north_m2,var_heading_rad2,x_m,y_m");
+  rtk_ = open("rtk.csv",
+              "stamp_ns,status,lat_deg,lon_deg,alt_m,heading_rad,var_east_m2,var_north_m2,var_heading_rad2,x_m,y_m");
   actors_ = open("actors.csv", "stamp_ns,name,type,x_m,y_m,yaw_rad");
 }
 
@@ -28,8 +30,8 @@ std::ofstream CsvStreams::open(const std::string& name, const std::string& heade
 }
 
 void CsvStreams::on_truth(const TruthSample& s) {
-  truth_ << s.stamp_ns << ',' << s.pose.x << ',' << s.pose.y << ',' << s.pose.yaw << ',' << s.speed << ','
-         << s.yaw_rate << ',' << s.steer << ',' << s.cross_track << '\n';
+  truth_ << s.stamp_ns << ',' << s.pose.x << ',' << s.pose.y << ',' << s.pose.yaw << ',' << s.speed << ',' << s.yaw_rate
+         << ',' << s.steer << ',' << s.cross_track << '\n';
   if (ego_path_.empty() || (ego_path_.back() - Eigen::Vector2d(s.pose.x, s.pose.y)).norm() > 0.5)
     ego_path_.emplace_back(s.pose.x, s.pose.y);
   cross_track_sq_ += s.cross_track * s.cross_track;
@@ -52,8 +54,8 @@ void CsvStreams::write_fix(std::ofstream& out, const GpsFix& f) {
   out.precision(12);
   out << ',' << f.lat_deg << ',' << f.lon_deg;
   out.precision(10);
-  out << ',' << f.alt_m << ',' << f.heading_rad << ',' << f.position_covariance[0] << ','
-      << f.position_covariance[4] << ',' << f.heading_variance << ',' << xy.x() << ',' << xy.y() << '\n';
+  out << ',' << f.alt_m << ',' << f.heading_rad << ',' << f.position_covariance[0] << ',' << f.position_covariance[4]
+      << ',' << f.heading_variance << ',' << xy.x() << ',' << xy.y() << '\n';
 }
 
 void CsvStreams::on_gps(const GpsFix& f) { write_fix(gps_, f); }
@@ -70,8 +72,8 @@ void CsvStreams::on_scan(const PointCloud& cloud, const Eigen::Isometry3d&) {
 
 void CsvStreams::on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) {
   for (const auto& a : actors) {
-    actors_ << stamp_ns << ',' << a.name << ',' << actor_type_name(a.type) << ',' << a.pose.x << ',' << a.pose.y
-            << ',' << a.pose.yaw << '\n';
+    actors_ << stamp_ns << ',' << a.name << ',' << actor_type_name(a.type) << ',' << a.pose.x << ',' << a.pose.y << ','
+            << a.pose.yaw << '\n';
     Polyline2d& path = actor_paths_[a.name];
     if (path.empty() || (path.back() - Eigen::Vector2d(a.pose.x, a.pose.y)).norm() > 0.5)
       path.emplace_back(a.pose.x, a.pose.y);

@@ -7,7 +7,11 @@
 
 using namespace lidarloop;
 
-static std::vector<Command> commands() { return {world_command(), scan_command(), validate_command(), simulate_command(), run_command(), compare_command(), replay_command(), map_command(), info_command(), export_command(), recover_command(), bench_command()}; }
+static std::vector<Command> commands() {
+  return {world_command(), scan_command(),    validate_command(), simulate_command(),
+          run_command(),   compare_command(), replay_command(),   map_command(),
+          info_command(),  export_command(),  recover_command(),  bench_command()};
+}
 
 static void print_usage(std::ostream& out) {
   out << "usage: lidarloop <command> [options]   (lidarloop <command> --help for details)\n\ncommands:\n";

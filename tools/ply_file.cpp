@@ -56,10 +56,14 @@ PointCloud read_ply(const std::string& path) {
     std::istringstream words(line);
     std::string tag;
     words >> tag;
-    if (tag == "format") binary = line == "format binary_little_endian 1.0";
-    else if (tag == "element") words >> tag >> count;
-    else if (tag == "property") properties += line + "\n";
-    else if (tag == "comment" && line.rfind("comment stamp_ns ", 0) == 0) cloud.stamp_ns = std::stoll(line.substr(17));
+    if (tag == "format")
+      binary = line == "format binary_little_endian 1.0";
+    else if (tag == "element")
+      words >> tag >> count;
+    else if (tag == "property")
+      properties += line + "\n";
+    else if (tag == "comment" && line.rfind("comment stamp_ns ", 0) == 0)
+      cloud.stamp_ns = std::stoll(line.substr(17));
   }
   if (!header_done || !binary || properties != kProperties)
     throw InputError(path + ": not a lidarloop scan PLY (unexpected header)");

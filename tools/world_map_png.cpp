@@ -15,10 +15,10 @@ namespace lidarloop {
 // Colours (BGR) by material name; anything else is drawn grey.
 static cv::Scalar colour(const std::string& material) {
   static const std::map<std::string, cv::Scalar> table = {
-      {"asphalt", {60, 60, 60}},         {"lane_paint", {255, 255, 255}}, {"crosswalk_paint", {235, 235, 235}},
-      {"curb_concrete", {170, 170, 170}}, {"sidewalk", {150, 160, 175}},  {"grass", {70, 140, 70}},
-      {"building", {120, 140, 190}},     {"vegetation", {40, 100, 40}},   {"vehicle_paint", {200, 80, 40}},
-      {"glass", {230, 200, 150}},        {"tyre", {20, 20, 20}},          {"metal", {180, 180, 200}},
+      {"asphalt", {60, 60, 60}},          {"lane_paint", {255, 255, 255}}, {"crosswalk_paint", {235, 235, 235}},
+      {"curb_concrete", {170, 170, 170}}, {"sidewalk", {150, 160, 175}},   {"grass", {70, 140, 70}},
+      {"building", {120, 140, 190}},      {"vegetation", {40, 100, 40}},   {"vehicle_paint", {200, 80, 40}},
+      {"glass", {230, 200, 150}},         {"tyre", {20, 20, 20}},          {"metal", {180, 180, 200}},
       {"retro_reflector", {0, 215, 255}}};
   const auto it = table.find(material);
   return it == table.end() ? cv::Scalar(128, 128, 128) : it->second;

@@ -26,9 +26,7 @@ void ByteWriter::patch(size_t pos, uint64_t v, int n) {
   put_le(buf_.data() + pos, v, n);
 }
 
-void ByteReader::fail(const std::string& problem) const {
-  throw InputError(context_ + ": " + problem);
-}
+void ByteReader::fail(const std::string& problem) const { throw InputError(context_ + ": " + problem); }
 
 uint64_t ByteReader::le(int n, const char* what) {
   if (remaining() < size_t(n)) fail(std::string(what) + " truncated");
@@ -43,8 +41,9 @@ uint32_t ByteReader::u32(const char* what) { return uint32_t(le(4, what)); }
 uint64_t ByteReader::u64(const char* what) { return le(8, what); }
 
 std::span<const uint8_t> ByteReader::bytes(size_t n, const char* what) {
-  if (remaining() < n) fail(std::string(what) + " truncated (" + std::to_string(n) + " bytes claimed, " +
-                            std::to_string(remaining()) + " left)");
+  if (remaining() < n)
+    fail(std::string(what) + " truncated (" + std::to_string(n) + " bytes claimed, " + std::to_string(remaining()) +
+         " left)");
   const auto out = data_.subspan(pos_, n);
   pos_ += n;
   return out;

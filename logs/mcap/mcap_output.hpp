@@ -27,7 +27,7 @@
 namespace lidarloop {
 
 struct ClosedChunk {
-  std::vector<uint8_t> records;  // uncompressed Message records
+  std::vector<uint8_t> records;                                                  // uncompressed Message records
   std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> index_entries;  // (log_time, offset)
   uint64_t start_time = 0, end_time = 0;
 };
@@ -78,8 +78,8 @@ class McapOutput {
     std::optional<ClosedChunk> chunk;
   };
   void push(Job job);
-  void run();                 // the worker thread
-  void process(Job& job);     // on the worker (or inline): compress, write, index
+  void run();              // the worker thread
+  void process(Job& job);  // on the worker (or inline): compress, write, index
   void emit(const uint8_t* data, size_t size, bool data_section);
   void rethrow();
 

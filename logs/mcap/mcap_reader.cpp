@@ -86,9 +86,15 @@ bool McapReader::next_in_chunk(McapMessage& out) {
     ByteReader in(prefix.bytes(size_t(length), "record"), context);
     chunk_pos_ += 9 + size_t(length);
     switch (mcap::Op(opcode)) {
-      case mcap::Op::schema: read_schema(in); break;
-      case mcap::Op::channel: read_channel(in); break;
-      case mcap::Op::message: read_message(in, out); return true;
+      case mcap::Op::schema:
+        read_schema(in);
+        break;
+      case mcap::Op::channel:
+        read_channel(in);
+        break;
+      case mcap::Op::message:
+        read_message(in, out);
+        return true;
       default:
         if (opcode < 0x80) in.fail(std::string("unexpected ") + mcap::op_name(opcode) + " record inside a chunk");
         break;  // 0x80-0xFF: application records, skipped
@@ -107,13 +113,27 @@ bool McapReader::next(McapMessage& out) {
     const std::string context = stream_.where(record_.offset) + " (" + mcap::op_name(record_.opcode) + ")";
     ByteReader in(record_.content, context);
     switch (mcap::Op(record_.opcode)) {
-      case mcap::Op::schema: read_schema(in); break;
-      case mcap::Op::channel: read_channel(in); break;
-      case mcap::Op::message: read_message(in, out); return true;
-      case mcap::Op::chunk: load_chunk(record_); break;
-      case mcap::Op::message_index: mcap::parse_message_index(in); break;
-      case mcap::Op::attachment: attachments_.push_back(mcap::parse_attachment(in)); break;
-      case mcap::Op::metadata: metadata_.push_back(mcap::parse_metadata(in)); break;
+      case mcap::Op::schema:
+        read_schema(in);
+        break;
+      case mcap::Op::channel:
+        read_channel(in);
+        break;
+      case mcap::Op::message:
+        read_message(in, out);
+        return true;
+      case mcap::Op::chunk:
+        load_chunk(record_);
+        break;
+      case mcap::Op::message_index:
+        mcap::parse_message_index(in);
+        break;
+      case mcap::Op::attachment:
+        attachments_.push_back(mcap::parse_attachment(in));
+        break;
+      case mcap::Op::metadata:
+        metadata_.push_back(mcap::parse_metadata(in));
+        break;
       case mcap::Op::data_end: {
         const uint32_t stored = mcap::parse_data_end(in);
         if (stored != 0 && stored != crc_before) in.fail("data section fails its CRC check (corrupt file)");
@@ -142,13 +162,27 @@ void McapReader::finish() {
     const std::string context = stream_.where(record_.offset) + " (" + mcap::op_name(record_.opcode) + ")";
     ByteReader in(record_.content, context);
     switch (mcap::Op(record_.opcode)) {
-      case mcap::Op::schema: mcap::parse_schema(in); break;
-      case mcap::Op::channel: mcap::parse_channel(in); break;
-      case mcap::Op::statistics: mcap::parse_statistics(in); break;
-      case mcap::Op::chunk_index: mcap::parse_chunk_index(in); break;
-      case mcap::Op::attachment_index: mcap::parse_attachment_index(in); break;
-      case mcap::Op::metadata_index: mcap::parse_metadata_index(in); break;
-      case mcap::Op::summary_offset: mcap::parse_summary_offset(in); break;
+      case mcap::Op::schema:
+        mcap::parse_schema(in);
+        break;
+      case mcap::Op::channel:
+        mcap::parse_channel(in);
+        break;
+      case mcap::Op::statistics:
+        mcap::parse_statistics(in);
+        break;
+      case mcap::Op::chunk_index:
+        mcap::parse_chunk_index(in);
+        break;
+      case mcap::Op::attachment_index:
+        mcap::parse_attachment_index(in);
+        break;
+      case mcap::Op::metadata_index:
+        mcap::parse_metadata_index(in);
+        break;
+      case mcap::Op::summary_offset:
+        mcap::parse_summary_offset(in);
+        break;
       case mcap::Op::footer: {
         const mcap::Footer footer = mcap::parse_footer(in);
         if (footer.summary_start != 0 && footer.summary_start != summary_start)
@@ -181,7 +215,8 @@ std::optional<McapSummary> read_mcap_summary(const std::string& path) {
   const auto tail = stream.peek(footer_at, 29 + 8);
   if (footer_at < 8 || !std::equal(tail.end() - 8, tail.end(), mcap::kMagic.begin()) ||
       tail[0] != uint8_t(mcap::Op::footer))
-    throw InputError(path + ": no footer at the end of the file: the log is truncated or was not closed "
+    throw InputError(path +
+                     ": no footer at the end of the file: the log is truncated or was not closed "
                      "(lidarloop recover can rebuild it)");
   stream.seek(footer_at);
   McapRecord record;
@@ -209,7 +244,8 @@ std::optional<McapSummary> read_mcap_summary(const std::string& path) {
   stream.seek(footer.summary_start);
   while (stream.position() < end) {
     stream.next(record);
-    if (stream.position() > end) throw InputError(stream.where(record.offset) + ": summary record overruns its section");
+    if (stream.position() > end)
+      throw InputError(stream.where(record.offset) + ": summary record overruns its section");
     ByteReader in(record.content, stream.where(record.offset) + " (" + mcap::op_name(record.opcode) + ")");
     switch (mcap::Op(record.opcode)) {
       case mcap::Op::schema: {
@@ -222,11 +258,20 @@ std::optional<McapSummary> read_mcap_summary(const std::string& path) {
         out.channels[c.id] = std::move(c);
         break;
       }
-      case mcap::Op::statistics: out.statistics = mcap::parse_statistics(in); break;
-      case mcap::Op::chunk_index: out.chunk_indexes.push_back(mcap::parse_chunk_index(in)); break;
-      case mcap::Op::attachment_index: out.attachment_indexes.push_back(mcap::parse_attachment_index(in)); break;
-      case mcap::Op::metadata_index: out.metadata_indexes.push_back(mcap::parse_metadata_index(in)); break;
-      default: break;
+      case mcap::Op::statistics:
+        out.statistics = mcap::parse_statistics(in);
+        break;
+      case mcap::Op::chunk_index:
+        out.chunk_indexes.push_back(mcap::parse_chunk_index(in));
+        break;
+      case mcap::Op::attachment_index:
+        out.attachment_indexes.push_back(mcap::parse_attachment_index(in));
+        break;
+      case mcap::Op::metadata_index:
+        out.metadata_indexes.push_back(mcap::parse_metadata_index(in));
+        break;
+      default:
+        break;
     }
   }
   return out;

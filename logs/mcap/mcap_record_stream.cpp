@@ -1,9 +1,9 @@
 #include "logs/mcap/mcap_record_stream.hpp"
 
+#include <sys/stat.h>
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <sys/stat.h>
 
 #include "common/input_error.hpp"
 #include "logs/mcap/mcap_records.hpp"
@@ -13,7 +13,7 @@ namespace lidarloop {
 McapRecordStream::McapRecordStream(const std::string& path) : path_(path) {
   file_ = std::fopen(path.c_str(), "rb");
   if (!file_) throw InputError(path + ": cannot open file (" + std::strerror(errno) + ")");
-  struct stat st{};
+  struct stat st {};
   if (fstat(fileno(file_), &st) != 0 || !S_ISREG(st.st_mode)) {
     std::fclose(file_);
     throw InputError(path + ": not a regular file");

@@ -47,10 +47,10 @@ std::map<uint16_t, uint64_t> parse_id_map(ByteReader& in, const char* what) {
 }  // namespace
 
 const char* op_name(uint8_t opcode) {
-  static constexpr const char* names[] = {"",           "Header",          "Footer",     "Schema",
-                                          "Channel",    "Message",         "Chunk",      "MessageIndex",
-                                          "ChunkIndex", "Attachment",      "AttachmentIndex", "Statistics",
-                                          "Metadata",   "MetadataIndex",   "SummaryOffset",   "DataEnd"};
+  static constexpr const char* names[] = {"",           "Header",        "Footer",          "Schema",
+                                          "Channel",    "Message",       "Chunk",           "MessageIndex",
+                                          "ChunkIndex", "Attachment",    "AttachmentIndex", "Statistics",
+                                          "Metadata",   "MetadataIndex", "SummaryOffset",   "DataEnd"};
   return opcode >= 1 && opcode <= 0x0F ? names[opcode] : "unknown";
 }
 

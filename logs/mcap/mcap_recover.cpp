@@ -58,9 +58,15 @@ class Recovery {
     try {
       ByteReader in(record.content, context);
       switch (mcap::Op(record.opcode)) {
-        case mcap::Op::schema: schema(in); break;
-        case mcap::Op::channel: channel(in); break;
-        case mcap::Op::message: message(in); break;
+        case mcap::Op::schema:
+          schema(in);
+          break;
+        case mcap::Op::channel:
+          channel(in);
+          break;
+        case mcap::Op::message:
+          message(in);
+          break;
         case mcap::Op::chunk:
           if (auto chunk = decode_chunk(record, context, report_)) write_chunk(*chunk, context);
           break;
@@ -126,10 +132,17 @@ class Recovery {
     for (const auto& item : chunk.items) {
       ByteReader in(std::span<const uint8_t>(chunk.records).subspan(item.offset, item.length), context);
       switch (mcap::Op(item.opcode)) {
-        case mcap::Op::schema: schema(in); break;
-        case mcap::Op::channel: channel(in); break;
-        case mcap::Op::message: message(in); break;
-        default: break;
+        case mcap::Op::schema:
+          schema(in);
+          break;
+        case mcap::Op::channel:
+          channel(in);
+          break;
+        case mcap::Op::message:
+          message(in);
+          break;
+        default:
+          break;
       }
     }
     ++report_.chunks;
@@ -221,7 +234,8 @@ McapRecoverReport recover_mcap(const std::string& broken, const std::string& fix
   McapRecoverReport report;
   report.input_bytes = in.file_size();
   const auto magic = in.peek(0, 8);
-  if (!std::equal(magic.begin(), magic.end(), mcap::kMagic.begin())) throw InputError(broken + ": not an MCAP file (bad magic)");
+  if (!std::equal(magic.begin(), magic.end(), mcap::kMagic.begin()))
+    throw InputError(broken + ": not an MCAP file (bad magic)");
 
   McapRecord record;
   if (magic.size() == 8) {

@@ -18,10 +18,10 @@ namespace lidarloop {
 struct McapRecoverReport {
   uint64_t input_bytes = 0;
   uint64_t chunks = 0, messages = 0, attachments = 0, metadata = 0;  // kept
-  uint64_t skipped_chunks = 0;   // framed correctly but corrupt
-  uint64_t skipped_bytes = 0;    // passed over while resynchronising, including a cut-off tail
-  uint64_t orphan_messages = 0;  // on channels whose definition was lost
-  bool complete = false;         // the input reached its Data End record: nothing was missing
+  uint64_t skipped_chunks = 0;                                       // framed correctly but corrupt
+  uint64_t skipped_bytes = 0;         // passed over while resynchronising, including a cut-off tail
+  uint64_t orphan_messages = 0;       // on channels whose definition was lost
+  bool complete = false;              // the input reached its Data End record: nothing was missing
   std::vector<std::string> problems;  // the first few, in file order
 };
 

@@ -1,9 +1,9 @@
 #include "logs/mcap/zstd_codec.hpp"
 
+#include <zstd.h>
 #include <algorithm>
 #include <memory>
 #include <stdexcept>
-#include <zstd.h>
 
 #include "common/input_error.hpp"
 

@@ -5,9 +5,9 @@
 #include <fstream>
 #include <string>
 
-#include <GeographicLib/Geodesic.hpp>
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <GeographicLib/Geodesic.hpp>
 
 #include "common/curb_map_file.hpp"
 #include "common/geodetic.hpp"
@@ -49,7 +49,8 @@ void expect_round_trip_on_grid(const Geodetic& origin, double half_x, double hal
       const Geodetic back = frame.to_geodetic(frame.to_local(g.lat_deg, g.lon_deg));
       worst_geodetic = std::max(worst_geodetic, geodesic_distance(g.lat_deg, g.lon_deg, back.lat_deg, back.lon_deg));
     }
-  EXPECT_LT(worst_local, kMillimetre) << "local -> WGS-84 -> local, origin " << origin.lat_deg << ", " << origin.lon_deg;
+  EXPECT_LT(worst_local, kMillimetre) << "local -> WGS-84 -> local, origin " << origin.lat_deg << ", "
+                                      << origin.lon_deg;
   EXPECT_LT(worst_geodetic, kMillimetre) << "WGS-84 -> local -> WGS-84, origin " << origin.lat_deg << ", "
                                          << origin.lon_deg;
 }
@@ -182,7 +183,8 @@ void expect_curb_map_error(const std::string& stem, const std::string& text, con
 // A valid collection around `features`, with the lidarloop.origin foreign member.
 std::string collection(const std::string& features) {
   return R"({"type": "FeatureCollection", "lidarloop": {"world": "w", "origin": [121.2147, 31.2856, 4.0]},
-            "features": [)" + features + "]}";
+            "features": [)" +
+         features + "]}";
 }
 
 TEST(GeodeticCurbMapFile, WriteReadRoundTrip) {
@@ -245,8 +247,7 @@ TEST(GeodeticCurbMapFile, NotAFeatureCollection) {
 }
 
 TEST(GeodeticCurbMapFile, PointGeometry) {
-  expect_curb_map_error("point",
-                        collection(R"({"type": "Feature", "properties": {},
+  expect_curb_map_error("point", collection(R"({"type": "Feature", "properties": {},
                                       "geometry": {"type": "Point", "coordinates": [121.2147, 31.2856]}})"),
                         "feature 0 is not a LineString");
 }

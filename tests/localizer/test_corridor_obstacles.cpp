@@ -7,8 +7,8 @@
 #include <random>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "localizer/driving_corridor.hpp"
 #include "localizer/obstacle_rejection.hpp"
@@ -179,7 +179,9 @@ Scene make_scene(unsigned seed, int n_ground, int n_obstacle_per_box) {
     const double x = ux(rng), y = uy(rng);
     add(x, y, plane_z(s, x, y) + noise(rng), false);
   }
-  struct Box { double x, y, lx, ly; };
+  struct Box {
+    double x, y, lx, ly;
+  };
   for (const Box& b : {Box{8, 2, 4.5, 1.8}, Box{-15, -3, 4.5, 1.8}, Box{22, -1, 10, 2.5}, Box{-4, 3.5, 0.6, 0.6}}) {
     for (int i = 0; i < n_obstacle_per_box; ++i) {
       const double x = b.x + (u01(rng) - 0.5) * b.lx, y = b.y + (u01(rng) - 0.5) * b.ly;
@@ -217,8 +219,9 @@ void check_scene(const Scene& s, const char* name) {
   ASSERT_EQ(split.ground.size() + split.obstacles.size(), s.points.size());
   const double precision = labelled ? double(labelled_true) / labelled : 0.0;
   const double recall = tall ? double(tall_found) / tall : 0.0;
-  std::printf("[ %s ] normal error %.4f deg, a2 %.4f (true %.2f), precision %.4f, recall %.4f (%zu obstacles of %zu points)\n",
-              name, err, split.plane.a2, s.offset, precision, recall, split.obstacles.size(), s.points.size());
+  std::printf(
+      "[ %s ] normal error %.4f deg, a2 %.4f (true %.2f), precision %.4f, recall %.4f (%zu obstacles of %zu points)\n",
+      name, err, split.plane.a2, s.offset, precision, recall, split.obstacles.size(), s.points.size());
   EXPECT_GE(precision, 0.99);
   EXPECT_GE(recall, 0.95);
 }

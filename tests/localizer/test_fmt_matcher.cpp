@@ -22,10 +22,10 @@ constexpr double kSpacing = 0.1;  // m between map curb points (the map's resolu
 
 // The junction sits far from the local origin, so a rotation about the wrong point shows.
 const Eigen::Vector2d kOrigin(150.0, -80.0);
-constexpr double kHalfRoad = 3.5;                     // two curbs 7 m apart along x
-constexpr double kRoadMin = -40, kRoadMax = 40;       // m along x, past the grid's +-25 m
-constexpr double kSideLeft = 1.0, kSideRight = 8.0;   // a side road going north, 7 m wide
-constexpr double kSideEnd = 30.0;                     // m north of the main road's axis
+constexpr double kHalfRoad = 3.5;                    // two curbs 7 m apart along x
+constexpr double kRoadMin = -40, kRoadMax = 40;      // m along x, past the grid's +-25 m
+constexpr double kSideLeft = 1.0, kSideRight = 8.0;  // a side road going north, 7 m wide
+constexpr double kSideEnd = 30.0;                    // m north of the main road's axis
 
 // The vehicle's true position (relative to kOrigin): on the main road, short of the junction.
 const Eigen::Vector2d kVehicle(-2.0, -1.0);
@@ -44,10 +44,10 @@ void add_line(std::vector<Eigen::Vector2d>& out, Eigen::Vector2d a, Eigen::Vecto
 
 std::vector<Eigen::Vector2d> junction_map() {
   std::vector<Eigen::Vector2d> map;
-  add_line(map, {kRoadMin, -kHalfRoad}, {kRoadMax, -kHalfRoad});       // south curb, unbroken
-  add_line(map, {kRoadMin, kHalfRoad}, {kSideLeft, kHalfRoad});        // north curb, west of the side road
-  add_line(map, {kSideRight, kHalfRoad}, {kRoadMax, kHalfRoad});       // north curb, east of it
-  add_line(map, {kSideLeft, kHalfRoad}, {kSideLeft, kSideEnd});        // the side road's curbs
+  add_line(map, {kRoadMin, -kHalfRoad}, {kRoadMax, -kHalfRoad});  // south curb, unbroken
+  add_line(map, {kRoadMin, kHalfRoad}, {kSideLeft, kHalfRoad});   // north curb, west of the side road
+  add_line(map, {kSideRight, kHalfRoad}, {kRoadMax, kHalfRoad});  // north curb, east of it
+  add_line(map, {kSideLeft, kHalfRoad}, {kSideLeft, kSideEnd});   // the side road's curbs
   add_line(map, {kSideRight, kHalfRoad}, {kSideRight, kSideEnd});
   return map;
 }
@@ -62,7 +62,7 @@ Pose2d correction_about_vehicle(double x, double y, double theta) {
 }
 
 struct Case {
-  Pose2d correction;                    // what fmt_match should find
+  Pose2d correction;                         // what fmt_match should find
   std::vector<Eigen::Vector2d> curbs_world;  // detected curbs placed in the world at the prior pose
   Eigen::Vector2d prior;                     // the prior position: the grid centre
   Eigen::Vector2d truth;                     // where the correction must take the prior
@@ -125,7 +125,9 @@ TEST(FmtMatcher, RecoversPureTranslationToOneCell) {
 TEST(FmtMatcher, SignConventions) {
   const auto map = junction_map();
   constexpr double kShift = 0.8, kTurn = 3.0 * kDeg;
-  struct Error { double x, y, yaw; };
+  struct Error {
+    double x, y, yaw;
+  };
   for (const Error e : {Error{kShift, 0, 0}, Error{0, kShift, 0}, Error{0, 0, kTurn}, Error{0, 0, -kTurn}}) {
     SCOPED_TRACE(testing::Message() << "error " << e.x << " m, " << e.y << " m, " << e.yaw / kDeg << " deg");
     const Case c = make_case(map, e.x, e.y, e.yaw);

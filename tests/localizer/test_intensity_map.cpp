@@ -390,14 +390,14 @@ TEST(IntensityMapIndex, PositiveAndNegativeCoordinates) {
   const IntensityMapHeader h = small_header();  // 0.5 m cells, 16 per 8 m tile
   const int last = kSmallTileCells - 1;
   expect_index(h, {0, 0}, {0, 0, 0, 0});
-  expect_index(h, {0.49, 0.51}, {0, 0, 0, 1});                // x east = column, y north = row
+  expect_index(h, {0.49, 0.51}, {0, 0, 0, 1});  // x east = column, y north = row
   expect_index(h, {3.2, 7.9}, {0, 0, 6, 15});
-  expect_index(h, {-1e-9, 0}, {-1, 0, last, 0});               // just west of the origin: tile -1
-  expect_index(h, {-0.5, -0.25}, {-1, -1, last, last});        // -0.5 starts cell -1
+  expect_index(h, {-1e-9, 0}, {-1, 0, last, 0});         // just west of the origin: tile -1
+  expect_index(h, {-0.5, -0.25}, {-1, -1, last, last});  // -0.5 starts cell -1
   expect_index(h, {-0.5000001, 0}, {-1, 0, last - 1, 0});
-  expect_index(h, {-kSmallTileSize, 0}, {-1, 0, 0, 0});        // tile -1 covers [-8, 0)
+  expect_index(h, {-kSmallTileSize, 0}, {-1, 0, 0, 0});  // tile -1 covers [-8, 0)
   expect_index(h, {-kSmallTileSize - 1e-9, 0}, {-2, 0, last, 0});
-  expect_index(h, {-100.25, 37.0}, {-13, 4, 7, 10});           // -100.25 / 0.5 = -200.5 -> cell -201
+  expect_index(h, {-100.25, 37.0}, {-13, 4, 7, 10});  // -100.25 / 0.5 = -200.5 -> cell -201
 }
 
 TEST(IntensityMapIndex, ExactTileBoundaries) {
@@ -447,9 +447,9 @@ TEST_F(IntensityMapFiles, SaveLoadRoundTrip) {
   EXPECT_EQ(got.resolution_m, h.resolution_m);
   EXPECT_EQ(got.tile_cells, h.tile_cells);
   EXPECT_EQ(got.build, h.build);
-  const std::vector<std::pair<int, int>> want_tiles = {
-      {-2, -2}, {-2, -1}, {-2, 0}, {-2, 1}, {-1, -2}, {-1, -1}, {-1, 0}, {-1, 1},
-      {0, -2},  {0, -1},  {0, 0},  {0, 1},  {1, -2},  {1, -1},  {1, 0},  {1, 1}};
+  const std::vector<std::pair<int, int>> want_tiles = {{-2, -2}, {-2, -1}, {-2, 0}, {-2, 1}, {-1, -2}, {-1, -1},
+                                                       {-1, 0},  {-1, 1},  {0, -2}, {0, -1}, {0, 0},   {0, 1},
+                                                       {1, -2},  {1, -1},  {1, 0},  {1, 1}};
   EXPECT_EQ(b.header().tiles, want_tiles);
   EXPECT_EQ(got.tiles, want_tiles);
 

@@ -35,7 +35,7 @@ std::vector<Eigen::Vector2d> road_map() {
   add_segment(m, {-30, 0}, {30, 0});
   add_segment(m, {-30, 10}, {-10, 10});
   add_segment(m, {10, 10}, {30, 10});
-  add_arc(m, {-10, 15}, 5, -std::numbers::pi / 2, 0);              // (-10, 10) -> (-5, 15)
+  add_arc(m, {-10, 15}, 5, -std::numbers::pi / 2, 0);                 // (-10, 10) -> (-5, 15)
   add_arc(m, {10, 15}, 5, std::numbers::pi, 1.5 * std::numbers::pi);  // (5, 15) -> (10, 10)
   add_segment(m, {-5, 15}, {-5, 35});
   add_segment(m, {5, 15}, {5, 35});
@@ -43,7 +43,7 @@ std::vector<Eigen::Vector2d> road_map() {
 }
 
 const Pose2d kTruth{0.8, -0.5, 3 * kDeg};  // the pose error ICP must find: truth.apply(curb) = map
-constexpr double kNoise = 0.02;                 // m, curb detection noise
+constexpr double kNoise = 0.02;            // m, curb detection noise
 constexpr size_t kInliers = 300;
 
 // Detected curbs: kInliers map points seen through the pose error, with noise. With `outliers`, 30 % of
@@ -61,7 +61,7 @@ std::vector<Eigen::Vector2d> detected_curbs(const std::vector<Eigen::Vector2d>& 
   std::vector<Eigen::Vector2d> curbs;
   for (size_t i = 0; i < kInliers; ++i) curbs.push_back(observe(map[pick(rng)]));
   if (outliers) {
-    constexpr int kParked = 100;  // one every 0.12 m
+    constexpr int kParked = 100;           // one every 0.12 m
     constexpr double kParkedOffset = 2.0;  // m from the bottom curb
     for (int k = 0; k < kParked; ++k) curbs.push_back(observe({-4.0 + 12.0 * k / kParked, kParkedOffset}));
     constexpr int kScattered = 29;  // pedestrians, bins, vegetation on the road surface
@@ -174,11 +174,12 @@ TEST(ProbabilisticIcp, RecoversOffsetDespiteParkedVansWherePlainIcpFails) {
   const IcpResult plain = icp(index, curbs, {}, no_rejection);
   const IcpResult gated = icp(index, curbs, {}, IcpParams{});  // default 2 m correspondence gate
   const IcpResult robust = m_icp(index, curbs, {}, MIcpParams{});
-  std::printf("probabilistic ICP: %.4f m %.4f deg outliers %.3f | plain ICP: %.4f m %.4f deg | "
-              "gated ICP: %.4f m %.4f deg | M-ICP: %.4f m %.4f deg\n",
-              translation_error(p.t), heading_error_deg(p.t), p.outlier_ratio, translation_error(plain.t),
-              heading_error_deg(plain.t), translation_error(gated.t), heading_error_deg(gated.t),
-              translation_error(robust.t), heading_error_deg(robust.t));
+  std::printf(
+      "probabilistic ICP: %.4f m %.4f deg outliers %.3f | plain ICP: %.4f m %.4f deg | "
+      "gated ICP: %.4f m %.4f deg | M-ICP: %.4f m %.4f deg\n",
+      translation_error(p.t), heading_error_deg(p.t), p.outlier_ratio, translation_error(plain.t),
+      heading_error_deg(plain.t), translation_error(gated.t), heading_error_deg(gated.t), translation_error(robust.t),
+      heading_error_deg(robust.t));
   EXPECT_LT(translation_error(p.t), 0.02);
   EXPECT_LT(heading_error_deg(p.t), 0.1);
   EXPECT_NEAR(p.outlier_ratio, 129.0 / 429.0, 0.02);  // the vans and the scattered returns, no more

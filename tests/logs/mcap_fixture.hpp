@@ -54,7 +54,11 @@ inline SyntheticRun make_synthetic_run(double seconds, int points, uint64_t seed
   run.mount.linear() = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const int64_t step = 10'000'000, end = int64_t(seconds * 1e9);
   for (int64_t t = step; t <= end; t += step) {
-    TruthSample s{t, {0.5 * double(t) * 1e-9 * 10, 2 + u(rng), 0.1 * u(rng)}, 10 + u(rng), 0.01 * u(rng), 0.02 * u(rng),
+    TruthSample s{t,
+                  {0.5 * double(t) * 1e-9 * 10, 2 + u(rng), 0.1 * u(rng)},
+                  10 + u(rng),
+                  0.01 * u(rng),
+                  0.02 * u(rng),
                   0.05 * u(rng)};
     run.truth.push_back(s);
     CanFrame c;

@@ -9,17 +9,17 @@
 #include <fstream>
 #include <random>
 
-#include "common/input_error.hpp"
-#include "mcap_fixture.hpp"
-#include "logs/cdr.hpp"
 #include "common/crc32.hpp"
+#include "common/input_error.hpp"
+#include "logs/cdr.hpp"
 #include "logs/log_export.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/mcap/mcap_recover.hpp"
+#include "logs/mcap/zstd_codec.hpp"
 #include "logs/ros2_messages.hpp"
 #include "logs/ros2_schemas.hpp"
-#include "logs/mcap/zstd_codec.hpp"
+#include "mcap_fixture.hpp"
 
 namespace lidarloop {
 namespace {
@@ -64,14 +64,22 @@ std::vector<Msg> read_all(const std::string& path) {
 // Decodes a message the way replay and export do, by its schema name.
 void decode(const McapMessage& m) {
   const std::string& type = m.schema ? m.schema->name : "";
-  if (type == "sensor_msgs/msg/PointCloud2") ros2::decode_point_cloud(m.data, "test");
-  else if (type == "sensor_msgs/msg/NavSatFix") ros2::decode_nav_sat_fix(m.data, "test");
-  else if (type == "lidarloop_msgs/msg/GnssHeading") ros2::decode_gnss_heading(m.data, "test");
-  else if (type == "lidarloop_msgs/msg/VehicleReport") ros2::decode_vehicle_report(m.data, "test");
-  else if (type == "lidarloop_msgs/msg/TruthState") ros2::decode_truth_state(m.data, "test");
-  else if (type == "nav_msgs/msg/Odometry") ros2::decode_odometry(m.data, "test");
-  else if (type == "tf2_msgs/msg/TFMessage") ros2::decode_tf(m.data, "test");
-  else if (type == "lidarloop_msgs/msg/ActorArray") ros2::decode_actor_array(m.data, "test");
+  if (type == "sensor_msgs/msg/PointCloud2")
+    ros2::decode_point_cloud(m.data, "test");
+  else if (type == "sensor_msgs/msg/NavSatFix")
+    ros2::decode_nav_sat_fix(m.data, "test");
+  else if (type == "lidarloop_msgs/msg/GnssHeading")
+    ros2::decode_gnss_heading(m.data, "test");
+  else if (type == "lidarloop_msgs/msg/VehicleReport")
+    ros2::decode_vehicle_report(m.data, "test");
+  else if (type == "lidarloop_msgs/msg/TruthState")
+    ros2::decode_truth_state(m.data, "test");
+  else if (type == "nav_msgs/msg/Odometry")
+    ros2::decode_odometry(m.data, "test");
+  else if (type == "tf2_msgs/msg/TFMessage")
+    ros2::decode_tf(m.data, "test");
+  else if (type == "lidarloop_msgs/msg/ActorArray")
+    ros2::decode_actor_array(m.data, "test");
 }
 
 class McapLog : public ::testing::Test {
@@ -109,8 +117,8 @@ TEST(Cdr, AlignsEachPrimitiveToItsSizeAfterTheHeader) {
   w.string("map");
   w.u8(7);
   w.f64(1.0);
-  const Bytes expected = {0, 1, 0, 0,  1, 0, 0, 0,  2, 0, 0, 0,  4, 0, 0, 0, 'm', 'a', 'p', 0,
-                          7, 0, 0, 0, 0, 0, 0, 0,  0, 0, 0, 0, 0, 0, 0xF0, 0x3F};
+  const Bytes expected = {0,   1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 4, 0, 0, 0, 'm',  'a',
+                          'p', 0, 7, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xF0, 0x3F};
   EXPECT_EQ(w.buffer(), expected);
   CdrReader r(w.buffer(), "test");
   EXPECT_EQ(r.i32(), 1);
@@ -205,19 +213,32 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
     EXPECT_GE(m.log_time, m.publish_time);
     last_log_time = m.log_time;
     const std::string& t = m.channel->topic;
-    if (t == topics::truth_state) truth.push_back(ros2::decode_truth_state(m.data, t));
-    else if (t == topics::vehicle_report) can.push_back(ros2::decode_vehicle_report(m.data, t));
-    else if (t == topics::gps_fix) gps.push_back(ros2::decode_nav_sat_fix(m.data, t));
-    else if (t == topics::rtk_fix) rtk.push_back(ros2::decode_nav_sat_fix(m.data, t));
-    else if (t == topics::gps_heading) gps_heading.push_back(ros2::decode_gnss_heading(m.data, t));
-    else if (t == topics::rtk_heading) rtk_heading.push_back(ros2::decode_gnss_heading(m.data, t));
-    else if (t == topics::scan) scans.push_back(ros2::decode_point_cloud(m.data, t));
-    else if (t == topics::estimate) estimates.push_back(ros2::decode_odometry(m.data, t));
-    else if (t == topics::truth_odometry) truth_odometry.push_back(ros2::decode_odometry(m.data, t));
-    else if (t == topics::truth_actors) actors.push_back(ros2::decode_actor_array(m.data, t));
-    else if (t == topics::tf_static) tf_static = ros2::decode_tf(m.data, t);
-    else if (t == topics::tf) ++tf;
-    else ADD_FAILURE() << "unexpected topic " << t;
+    if (t == topics::truth_state)
+      truth.push_back(ros2::decode_truth_state(m.data, t));
+    else if (t == topics::vehicle_report)
+      can.push_back(ros2::decode_vehicle_report(m.data, t));
+    else if (t == topics::gps_fix)
+      gps.push_back(ros2::decode_nav_sat_fix(m.data, t));
+    else if (t == topics::rtk_fix)
+      rtk.push_back(ros2::decode_nav_sat_fix(m.data, t));
+    else if (t == topics::gps_heading)
+      gps_heading.push_back(ros2::decode_gnss_heading(m.data, t));
+    else if (t == topics::rtk_heading)
+      rtk_heading.push_back(ros2::decode_gnss_heading(m.data, t));
+    else if (t == topics::scan)
+      scans.push_back(ros2::decode_point_cloud(m.data, t));
+    else if (t == topics::estimate)
+      estimates.push_back(ros2::decode_odometry(m.data, t));
+    else if (t == topics::truth_odometry)
+      truth_odometry.push_back(ros2::decode_odometry(m.data, t));
+    else if (t == topics::truth_actors)
+      actors.push_back(ros2::decode_actor_array(m.data, t));
+    else if (t == topics::tf_static)
+      tf_static = ros2::decode_tf(m.data, t);
+    else if (t == topics::tf)
+      ++tf;
+    else
+      ADD_FAILURE() << "unexpected topic " << t;
   }
   const auto& run = *run_;
   ASSERT_EQ(truth.size(), run.truth.size());
@@ -234,8 +255,8 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
   ASSERT_EQ(rtk.size(), run.rtk.size());
   ASSERT_EQ(gps_heading.size(), run.gps.size());
   for (size_t i = 0; i < gps.size(); ++i) {
-    for (const auto& [got, heading, want] : {std::tuple{gps[i], gps_heading[i], run.gps[i]},
-                                             std::tuple{rtk[i], rtk_heading[i], run.rtk[i]}}) {
+    for (const auto& [got, heading, want] :
+         {std::tuple{gps[i], gps_heading[i], run.gps[i]}, std::tuple{rtk[i], rtk_heading[i], run.rtk[i]}}) {
       EXPECT_TRUE(got.stamp_ns == want.stamp_ns && got.status == want.status && got.lat_deg == want.lat_deg &&
                   got.lon_deg == want.lon_deg && got.alt_m == want.alt_m &&
                   got.position_covariance == want.position_covariance);
@@ -256,8 +277,8 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
   }
   ASSERT_EQ(estimates.size(), run.estimates.size());
   for (size_t i = 0; i < estimates.size(); ++i) {
-    const auto &o = estimates[i];
-    const auto &e = run.estimates[i];
+    const auto& o = estimates[i];
+    const auto& e = run.estimates[i];
     EXPECT_EQ(o.stamp_ns, e.stamp_ns);
     EXPECT_EQ(o.frame_id, "map");
     EXPECT_EQ(o.child_frame_id, "base_link_estimate");
@@ -314,7 +335,8 @@ TEST_F(McapLog, SummaryAndIndexesDescribeTheData) {
   // they cover every message of the chunk (what indexed readers such as Foxglove rely on).
   const Bytes file = read_file(*path_);
   for (const auto& ci : summary->chunk_indexes) {
-    ByteReader chunk_in(std::span<const uint8_t>(file).subspan(ci.chunk_start_offset + 9, ci.chunk_length - 9), "chunk");
+    ByteReader chunk_in(std::span<const uint8_t>(file).subspan(ci.chunk_start_offset + 9, ci.chunk_length - 9),
+                        "chunk");
     const mcap::Chunk chunk = mcap::parse_chunk(chunk_in);
     EXPECT_EQ(chunk.compression, "zstd");
     EXPECT_EQ(ci.compressed_size, chunk.records.size());

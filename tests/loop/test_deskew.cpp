@@ -20,18 +20,17 @@ double wall_spread(bool compensate, double speed, double yaw_rate) {
   config.scan_start_yaw_deg = 0;  // first and last firings look straight ahead
   RayScene scene(mesh);
   const LidarScanner scanner(config, test::materials());
-  const PointCloud cloud =
-      scanner.scan(scene, constant_twist(Eigen::Isometry3d::Identity(), 0, speed, yaw_rate), 0, 1);
+  const PointCloud cloud = scanner.scan(scene, constant_twist(Eigen::Isometry3d::Identity(), 0, speed, yaw_rate), 0, 1);
   const int64_t end = config.cycles_per_scan() * config.cycle_period_ns();
   // Where the car is at the end of the scan, to put the truth in the same frame.
   const Eigen::Isometry3d end_pose = constant_twist(Eigen::Isometry3d::Identity(), 0, speed, yaw_rate)(end);
-  const auto points = compensate ? deskew(cloud, config.mount(), {speed, yaw_rate}, end)
-                                 : to_vehicle_frame(cloud, config.mount());
+  const auto points =
+      compensate ? deskew(cloud, config.mount(), {speed, yaw_rate}, end) : to_vehicle_frame(cloud, config.mount());
   double lo = INFINITY, hi = -INFINITY;
   for (size_t i = 0; i < cloud.points.size(); ++i) {
     const LidarPoint& p = cloud.points[i];
     if (p.ring != 23 || std::abs(p.y) > 1.0) continue;
-    const bool early = p.t_ns < 2'000'000, late = int64_t(p.t_ns) > end - 2'000'000;
+    const bool early = p.t_ns<2'000'000, late = int64_t(p.t_ns)> end - 2'000'000;
     if (!early && !late) continue;
     // The wall's face is the world plane x = 24.5: compare in the world through the end pose.
     const Eigen::Vector3d world = end_pose * points.xyz[i];

@@ -9,8 +9,8 @@
 
 #include "localizer/curb_layer.hpp"
 #include "localizer/hd_map.hpp"
-#include "test_support.hpp"
 #include "loop/mapping_drive.hpp"
+#include "test_support.hpp"
 
 namespace lidarloop {
 namespace {
@@ -62,8 +62,10 @@ struct Survey {
       const World w = build_world(d, test::materials(), test::data_path("assets/actors"));
       MappingOptions o;
       o.traffic = traffic;
-      it = built.emplace(traffic, run_mapping_drive(d, w, test::materials(), test::data_path("assets/actors"), o,
-                                                    "test")).first;
+      it =
+          built
+              .emplace(traffic, run_mapping_drive(d, w, test::materials(), test::data_path("assets/actors"), o, "test"))
+              .first;
     }
     return it->second;
   }

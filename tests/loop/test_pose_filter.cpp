@@ -58,7 +58,8 @@ GpsOnly run_gps_only(uint64_t can_seed, uint64_t gps_seed) {
     for (const CanFrame& f : can.deliver(t)) {
       const double v = 0.5 * (f.wheel_speed_mps[2] + f.wheel_speed_mps[3]);
       const double dt = last.stamp_ns ? double(f.stamp_ns - last.stamp_ns) * 1e-9 : 0.01;
-      const Pose2d predicted = predictor.predict(filter.pose(), v, f.steering_wheel_angle_rad / VehicleModelParams{}.steering_ratio, dt);
+      const Pose2d predicted =
+          predictor.predict(filter.pose(), v, f.steering_wheel_angle_rad / VehicleModelParams{}.steering_ratio, dt);
       filter.predict(predicted, v * dt, dt);
       last = f;
     }
@@ -85,8 +86,8 @@ TEST(PoseFilter, WithGpsAloneTheEstimateBeatsRawGps) {
   for (auto [can_seed, gps_seed] : {std::pair<uint64_t, uint64_t>{5, 6}, {7, 8}, {9, 10}}) {
     const GpsOnly r = run_gps_only(can_seed, gps_seed);
     std::cout << "[ figures  ] position RMSE: raw GPS " << r.raw << " m, filtered " << r.filtered
-              << " m; heading RMSE: raw " << r.raw_yaw * 180 / M_PI << " deg, filtered "
-              << r.filtered_yaw * 180 / M_PI << " deg\n";
+              << " m; heading RMSE: raw " << r.raw_yaw * 180 / M_PI << " deg, filtered " << r.filtered_yaw * 180 / M_PI
+              << " deg\n";
     EXPECT_LT(r.filtered, r.raw);
     EXPECT_LT(r.filtered_yaw, 0.8 * r.raw_yaw);
   }

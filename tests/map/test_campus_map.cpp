@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "localizer/hd_map.hpp"
-#include "sim/ray_scene.hpp"
 #include "loop/map_cache.hpp"
+#include "sim/ray_scene.hpp"
 #include "sim/world_assets.hpp"
 
 namespace lidarloop {
@@ -37,22 +37,22 @@ TEST(CampusMap, PaintCellsAreAtLeastThreeTimesBrighterThanAsphalt) {
   };
   constexpr double kPaintReach = 0.05, kAsphaltReach = 0.3;
   double sum[3] = {0, 0, 0};
-  int n[3] = {0, 0, 0};  // asphalt, lane paint, crosswalk paint
+  int n[3] = {0, 0, 0};                        // asphalt, lane paint, crosswalk paint
   constexpr double kAlong = 0.5, kInto = 5.0;  // m: walk along every curb, up to 5 m into the road
   for (const auto& line : w.world.curbs)
     for (size_t i = 1; i < line.size(); ++i) {
       const Eigen::Vector2d d = line[i] - line[i - 1];
       const Eigen::Vector2d left = Eigen::Vector2d(-d.y(), d.x()).normalized();  // the road is on the left
       for (double along = 0; along < d.norm(); along += kAlong)
-      for (double into = 0.3; into < kInto; into += res) {
-        const Eigen::Vector2d c = line[i - 1] + d.normalized() * along + left * into;
-        const auto cell = map.intensity.cell(c);
-        if (!cell || cell->count < 3) continue;
-        const int centre = material_at(c.x(), c.y());
-        const int m = uniform_material(c.x(), c.y(), centre == asphalt ? kAsphaltReach : kPaintReach);
-        const int k = m == asphalt ? 0 : m == lane ? 1 : m == zebra ? 2 : -1;
-        if (k >= 0) sum[k] += cell->mean, ++n[k];
-      }
+        for (double into = 0.3; into < kInto; into += res) {
+          const Eigen::Vector2d c = line[i - 1] + d.normalized() * along + left * into;
+          const auto cell = map.intensity.cell(c);
+          if (!cell || cell->count < 3) continue;
+          const int centre = material_at(c.x(), c.y());
+          const int m = uniform_material(c.x(), c.y(), centre == asphalt ? kAsphaltReach : kPaintReach);
+          const int k = m == asphalt ? 0 : m == lane ? 1 : m == zebra ? 2 : -1;
+          if (k >= 0) sum[k] += cell->mean, ++n[k];
+        }
     }
   ASSERT_GT(n[0], 1000);
   ASSERT_GT(n[1], 50);

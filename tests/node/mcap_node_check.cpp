@@ -9,8 +9,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "common/input_error.hpp"
 #include "../logs/mcap_fixture.hpp"
+#include "common/input_error.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 
@@ -46,19 +46,18 @@ int compare(const std::string& mcap, const std::string& json_path) {
   const json node = json::parse(in);
   const test::SyntheticRun run = the_run();
   namespace t = log_topics;
-  const std::map<std::string, size_t> written = {
-      {t::tf_static, 1},
-      {t::vehicle_report, run.can.size()},
-      {t::truth_state, run.truth.size()},
-      {t::truth_odometry, run.truth.size()},
-      {t::tf, run.truth.size() + run.estimates.size()},
-      {t::gps_fix, run.gps.size()},
-      {t::gps_heading, run.gps.size()},
-      {t::rtk_fix, run.rtk.size()},
-      {t::rtk_heading, run.rtk.size()},
-      {t::scan, run.scans.size()},
-      {t::truth_actors, run.actors.size()},
-      {t::estimate, run.estimates.size()}};
+  const std::map<std::string, size_t> written = {{t::tf_static, 1},
+                                                 {t::vehicle_report, run.can.size()},
+                                                 {t::truth_state, run.truth.size()},
+                                                 {t::truth_odometry, run.truth.size()},
+                                                 {t::tf, run.truth.size() + run.estimates.size()},
+                                                 {t::gps_fix, run.gps.size()},
+                                                 {t::gps_heading, run.gps.size()},
+                                                 {t::rtk_fix, run.rtk.size()},
+                                                 {t::rtk_heading, run.rtk.size()},
+                                                 {t::scan, run.scans.size()},
+                                                 {t::truth_actors, run.actors.size()},
+                                                 {t::estimate, run.estimates.size()}};
   expect_equal("counts per topic", node.at("counts").get<std::map<std::string, size_t>>(), written);
 
   // And the C++ reader sees the same file the same way.
@@ -71,9 +70,10 @@ int compare(const std::string& mcap, const std::string& json_path) {
 
   const json& scan = node.at("first_scan");
   const PointCloud& first = run.scans.at(0);
-  expect_equal("first scan stamp", scan.at("stamp").at("sec").get<int64_t>() * 1'000'000'000 +
-                                       scan.at("stamp").at("nanosec").get<int64_t>(),
-               first.stamp_ns);
+  expect_equal(
+      "first scan stamp",
+      scan.at("stamp").at("sec").get<int64_t>() * 1'000'000'000 + scan.at("stamp").at("nanosec").get<int64_t>(),
+      first.stamp_ns);
   expect_equal("first scan frame", scan.at("frame_id").get<std::string>(), std::string(t::lidar_frame));
   expect_equal("first scan width", scan.at("width").get<size_t>(), first.points.size());
   expect_equal("first scan fields", scan.at("fields").get<std::vector<std::string>>(),

@@ -44,9 +44,9 @@ TEST(ActorsInScans, AParkedBusHidesWhatIsBehindIt) {
   auto count_through_body = [&](bool with_bus, int& wall_points) {
     RayScene scene(mesh);
     if (with_bus) {
-      scene.add_actor(scene.add_prototype(load_actor_mesh(test::data_path("assets/actors"), ActorType::bus,
-                                                          test::materials())),
-                      at(0, -5));
+      scene.add_actor(
+          scene.add_prototype(load_actor_mesh(test::data_path("assets/actors"), ActorType::bus, test::materials())),
+          at(0, -5));
       scene.commit();
     }
     const LidarScanner scanner(config, test::materials());
@@ -63,7 +63,7 @@ TEST(ActorsInScans, AParkedBusHidesWhatIsBehindIt) {
   int wall_without = 0, wall_with = 0;
   EXPECT_GT(count_through_body(false, wall_without), 500);  // the shadow is not empty without the bus
   EXPECT_EQ(count_through_body(true, wall_with), 0);
-  EXPECT_GT(wall_with, 1000);                               // the rest of the wall is still seen
+  EXPECT_GT(wall_with, 1000);  // the rest of the wall is still seen
   EXPECT_LT(wall_with, wall_without);
 }
 
@@ -71,17 +71,16 @@ TEST(ActorsInScans, AMovingActorIsSeenWhereItIsAtEachFiring) {
   // A 12 m bus drives past on the right at 10 m/s: it moves 1 m during the scan.
   const TriangleMesh ground = test::flat_ground(60);
   RayScene scene(ground);
-  scene.add_actor(scene.add_prototype(load_actor_mesh(test::data_path("assets/actors"), ActorType::bus,
-                                                      test::materials())),
-                  at(-10, -5));
+  scene.add_actor(
+      scene.add_prototype(load_actor_mesh(test::data_path("assets/actors"), ActorType::bus, test::materials())),
+      at(-10, -5));
   scene.commit();
   const double speed = 10, half_length = 6.05;
   auto bus_x = [&](int64_t t_ns) { return -10.0 + speed * double(t_ns) * 1e-9; };
   const ActorPoses poses = [&](int64_t t, std::vector<Eigen::Isometry3d>& out) { out[0] = at(bus_x(t), -5); };
   const Hdl32eConfig config = test::noiseless_hdl32e();
   const LidarScanner scanner(config, test::materials());
-  const PointCloud cloud =
-      scanner.scan(scene, constant_twist(Eigen::Isometry3d::Identity(), 0, 0, 0), 0, 1, poses);
+  const PointCloud cloud = scanner.scan(scene, constant_twist(Eigen::Isometry3d::Identity(), 0, 0, 0), 0, 1, poses);
   int on_bus = 0, beyond_start = 0;
   for (const auto& p : cloud.points) {
     const Eigen::Vector3d w = config.mount_xyz + Eigen::Vector3d(p.x, p.y, p.z);

@@ -4,8 +4,8 @@
 
 #include "sim/lidar_scanner.hpp"
 #include "sim/polyline.hpp"
-#include "test_support.hpp"
 #include "sim/world_assets.hpp"
+#include "test_support.hpp"
 
 namespace lidarloop {
 namespace {

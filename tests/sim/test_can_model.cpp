@@ -100,8 +100,8 @@ DriveResult drive_circle(const CanConfig& config, uint64_t seed) {
   const CanModel probe(config, seed);
   const int frames = int(kDriveNs / probe.period_ns());
   // Frames measured over [0, drive) arrive over [latency, drive + latency).
-  const DeadReckoning dr = dead_reckon(run(config, seed, frames, constant(circle_truth())), config.latency_ns,
-                                       kDriveNs + config.latency_ns);
+  const DeadReckoning dr =
+      dead_reckon(run(config, seed, frames, constant(circle_truth())), config.latency_ns, kDriveNs + config.latency_ns);
   const double distance = kCircleSpeed * double(kDriveNs) * kNsToS;
   const double angle = distance / kCircleRadius;  // starting at the origin heading +x, turning left
   const double end_x = kCircleRadius * std::sin(angle), end_y = kCircleRadius * (1 - std::cos(angle));

@@ -124,8 +124,8 @@ TEST(GpsErrorStatistics, CovarianceReportsTheConfiguredVariances) {
   GpsModel gps(config, LocalFrame(kOrigin), 1);
   const GpsFix fix = gps.sample(0, circle_truth(0));
   const double horizontal = config.bias_sigma_m * config.bias_sigma_m + config.white_sigma_m * config.white_sigma_m;
-  const std::array<double, 9> expected{horizontal, 0, 0, 0, horizontal, 0, 0, 0,
-                                       config.vertical_sigma_m * config.vertical_sigma_m};
+  const std::array<double, 9> expected{
+      horizontal, 0, 0, 0, horizontal, 0, 0, 0, config.vertical_sigma_m * config.vertical_sigma_m};
   EXPECT_EQ(fix.status, GpsStatus::fix);
   for (size_t i = 0; i < expected.size(); ++i) EXPECT_DOUBLE_EQ(fix.position_covariance[i], expected[i]) << i;
   EXPECT_DOUBLE_EQ(fix.heading_variance, config.heading_bias_sigma_rad * config.heading_bias_sigma_rad +
@@ -245,8 +245,8 @@ TEST(GpsHeading, WrappedIntoMinusPiToPi) {
 constexpr int64_t kZoneRunNs = 10 * 60 * kSecond;  // ~9.5 laps of the circle
 
 bool inside(const GpsZone& zone, int64_t t_ns, const Pose2d& truth) {
-  const bool in_space = zone.radius_m == 0 || std::hypot(truth.x - zone.centre.x(), truth.y - zone.centre.y()) <=
-                                                  zone.radius_m;
+  const bool in_space =
+      zone.radius_m == 0 || std::hypot(truth.x - zone.centre.x(), truth.y - zone.centre.y()) <= zone.radius_m;
   return in_space && t_ns >= zone.from_ns && t_ns < zone.to_ns;
 }
 
@@ -409,7 +409,9 @@ TEST(GpsModelSetup, RejectsBadConfigurationAndTimeGoingBack) {
   EXPECT_THROW(GpsModel(with([](GpsConfig& c) { c.bias_sigma_m = -1; }), frame, 0), std::invalid_argument);
   EXPECT_THROW(GpsModel(with([](GpsConfig& c) { c.bias_tau_s = 0; }), frame, 0), std::invalid_argument);
   EXPECT_THROW(GpsModel(with([](GpsConfig& c) { c.heading_bias_tau_s = -5; }), frame, 0), std::invalid_argument);
-  EXPECT_THROW(GpsModel(with([](GpsConfig& c) { c.white_sigma_m = std::numeric_limits<double>::quiet_NaN(); }), frame, 0), std::invalid_argument);
+  EXPECT_THROW(
+      GpsModel(with([](GpsConfig& c) { c.white_sigma_m = std::numeric_limits<double>::quiet_NaN(); }), frame, 0),
+      std::invalid_argument);
   EXPECT_THROW(GpsModel(with([](GpsConfig& c) { c.zones.push_back(GpsZone{.radius_m = -1}); }), frame, 0),
                std::invalid_argument);
   EXPECT_THROW(RtkModel(RtkConfig{.rate_hz = -1}, frame, 0), std::invalid_argument);

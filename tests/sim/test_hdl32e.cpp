@@ -118,7 +118,7 @@ double wall_shift(bool motion_distortion) {
     if (p.t_ns < t_first) t_first = p.t_ns, first = p.x;
     if (int64_t(p.t_ns) > t_last) t_last = p.t_ns, last = p.x;
   }
-  EXPECT_LT(t_first, 100000);  // within the first 0.1 ms
+  EXPECT_LT(t_first, 100000);   // within the first 0.1 ms
   EXPECT_GT(t_last, 99000000);  // within the last 1 ms of the 100 ms scan
   return first - last;
 }

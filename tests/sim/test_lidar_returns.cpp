@@ -9,8 +9,8 @@ namespace lidarloop {
 namespace {
 
 int intensity(const ReturnModel& model, const std::string& material, double range, double cos_incidence) {
-  const auto r = model(test::materials()[test::materials().id(material, "test")], range, cos_incidence, 5,
-                       CounterRng(1, 2), 3);
+  const auto r =
+      model(test::materials()[test::materials().id(material, "test")], range, cos_incidence, 5, CounterRng(1, 2), 3);
   return r ? r->intensity : -1;
 }
 
@@ -40,7 +40,8 @@ TEST(LidarReturns, RetroReflectorsReadAbove100AndDiffuseSurfacesAtMost100) {
   EXPECT_GT(intensity(model, "retro_reflector", 40.0, 0.5), 100);
   EXPECT_LE(intensity(model, "grass", 2.0, 1.0), 100);
   // A diffuse target of reflectivity rho at normal incidence and reference range reads ~100 rho.
-  EXPECT_NEAR(intensity(model, "building", 10.0, 1.0), 100 * 0.40, 100 * 0.40 * test::noiseless_hdl32e().laser_gain_spread + 1);
+  EXPECT_NEAR(intensity(model, "building", 10.0, 1.0), 100 * 0.40,
+              100 * 0.40 * test::noiseless_hdl32e().laser_gain_spread + 1);
 }
 
 TEST(LidarReturns, WeakAndGrazingReturnsAreLost) {
@@ -58,8 +59,9 @@ TEST(LidarReturns, PaintStripeStandsOutInAScan) {
   // Asphalt with one 0.15 m lane line 3 m to the left, along the direction of travel.
   TriangleMesh mesh = test::flat_ground(40);
   const MaterialId paint = test::materials().id("lane_paint", "test");
-  add_flat_quad(mesh, {Eigen::Vector2f(-40, 2.925f), Eigen::Vector2f(40, 2.925f), Eigen::Vector2f(40, 3.075f),
-                       Eigen::Vector2f(-40, 3.075f)},
+  add_flat_quad(mesh,
+                {Eigen::Vector2f(-40, 2.925f), Eigen::Vector2f(40, 2.925f), Eigen::Vector2f(40, 3.075f),
+                 Eigen::Vector2f(-40, 3.075f)},
                 0.003f, paint);
   RayScene scene(mesh);
   const Hdl32eConfig config;
@@ -70,8 +72,10 @@ TEST(LidarReturns, PaintStripeStandsOutInAScan) {
   for (const auto& p : cloud.points) {
     const double y = p.y + config.mount_xyz.y(), x = p.x + config.mount_xyz.x();
     if (p.z > -1.5 || std::abs(x) > 15) continue;
-    if (std::abs(y - 3.0) < 0.05) on += p.intensity, ++n_on;
-    else if (std::abs(y - 3.0) > 0.3 && std::abs(y - 3.0) < 1.0) off += p.intensity, ++n_off;
+    if (std::abs(y - 3.0) < 0.05)
+      on += p.intensity, ++n_on;
+    else if (std::abs(y - 3.0) > 0.3 && std::abs(y - 3.0) < 1.0)
+      off += p.intensity, ++n_off;
   }
   ASSERT_GT(n_on, 20);
   ASSERT_GT(n_off, 100);

@@ -58,7 +58,8 @@ double mesh_area(const TriangleMesh& mesh) {
   double total = 0;
   for (const auto& t : mesh.triangles) {
     const Eigen::Vector3f &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
-    total += 0.5 * ((double(b.x()) - a.x()) * (double(c.y()) - a.y()) - (double(b.y()) - a.y()) * (double(c.x()) - a.x()));
+    total +=
+        0.5 * ((double(b.x()) - a.x()) * (double(c.y()) - a.y()) - (double(b.y()) - a.y()) * (double(c.x()) - a.x()));
   }
   return total;
 }
@@ -100,8 +101,21 @@ TEST(RegionTriangulate, CollinearPoints) {
   // Points in the middle of edges (as tile clipping produces): no zero-area triangles, same area.
   const Path square = path_m({{0, 0}, {5, 0}, {10, 0}, {10, 5}, {10, 10}, {5, 10}, {0, 10}, {0, 5}});
   expect_exact_triangulation(square, "square with mid-edge points");
-  const Path comb = path_m({{0, 0}, {4, 0}, {8, 0}, {12, 0}, {12, 3}, {9, 3}, {9, 1}, {7, 1}, {7, 3}, {3, 3},
-                            {3, 1}, {1, 1}, {1, 3}, {0, 3}, {0, 1.5}});
+  const Path comb = path_m({{0, 0},
+                            {4, 0},
+                            {8, 0},
+                            {12, 0},
+                            {12, 3},
+                            {9, 3},
+                            {9, 1},
+                            {7, 1},
+                            {7, 3},
+                            {3, 3},
+                            {3, 1},
+                            {1, 1},
+                            {1, 3},
+                            {0, 3},
+                            {0, 1.5}});
   expect_exact_triangulation(comb, "comb with collinear points");
 }
 
@@ -117,7 +131,8 @@ TEST(RegionMesh, SquareWithCircularHole) {
 
   TriangleMesh mesh;
   constexpr MaterialId kMaterial = 7;
-  region::mesh_region(ring, kTile, [](const Eigen::Vector2d&) { return kHeight; }, kMaterial, mesh);
+  region::mesh_region(
+      ring, kTile, [](const Eigen::Vector2d&) { return kHeight; }, kMaterial, mesh);
   ASSERT_GT(mesh.triangle_count(), 0u);
   EXPECT_NEAR(mesh_area(mesh), region::area(ring), 1e-3 * region::area(ring));
   for (size_t i = 0; i < mesh.triangle_count(); ++i) {
@@ -129,7 +144,8 @@ TEST(RegionMesh, SquareWithCircularHole) {
       centroid += mesh.vertices[v].cast<double>() / 3;
     }
     // Every triangle faces up (counter-clockwise from above) and lies in the region, not in the hole.
-    const Eigen::Vector3f n = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+    const Eigen::Vector3f n =
+        (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
     EXPECT_GT(n.z(), 0) << "triangle " << i;
     EXPECT_TRUE(region::contains(ring, centroid.head<2>())) << "triangle " << i << " centroid " << centroid.transpose();
   }
@@ -141,8 +157,8 @@ TEST(RegionMesh, TilesFollowTheGlobalGrid) {
   // touching the edge are at most one tile (inside, whole covered squares may be larger).
   constexpr double kTile = 8.0, kHalf = 20.0;
   TriangleMesh mesh;
-  region::mesh_region(region::rectangle({0, 0}, {1, 0}, kHalf, kHalf), kTile,
-                      [](const Eigen::Vector2d&) { return 0.0f; }, 0, mesh);
+  region::mesh_region(
+      region::rectangle({0, 0}, {1, 0}, kHalf, kHalf), kTile, [](const Eigen::Vector2d&) { return 0.0f; }, 0, mesh);
   EXPECT_NEAR(mesh_area(mesh), 4 * kHalf * kHalf, 1e-3);
   auto on_grid_or_edge = [&](float v) {
     return std::abs(std::abs(v) - kHalf) < 1e-4 || std::abs(v / kTile - std::round(v / kTile)) < 1e-6;
@@ -172,8 +188,7 @@ TEST(RegionStrip, ClosedCentrelineIsARing) {
   // A closed 100 m square centreline: the ring has sharp inner corners and round outer ones,
   // area = outer (A + P h + pi h^2) - inner ((side - 2h)^2).
   constexpr double kSide = 100.0, kHalfWidth = 5.0;
-  const region::Paths ring =
-      region::strip({{0, 0}, {kSide, 0}, {kSide, kSide}, {0, kSide}, {0, 0}}, kHalfWidth, true);
+  const region::Paths ring = region::strip({{0, 0}, {kSide, 0}, {kSide, kSide}, {0, kSide}, {0, 0}}, kHalfWidth, true);
   const double outer = kSide * kSide + 4 * kSide * kHalfWidth + std::numbers::pi * kHalfWidth * kHalfWidth;
   const double inner = (kSide - 2 * kHalfWidth) * (kSide - 2 * kHalfWidth);
   EXPECT_NEAR(region::area(ring), outer - inner, 1e-3 * (outer - inner));
@@ -218,8 +233,7 @@ TEST(RegionClipLines, RemovesThePartInsideASquare) {
   double length = 0;
   for (const auto& piece : out) {
     length += polyline_length(piece);
-    for (size_t i = 1; i < piece.size(); ++i)
-      EXPECT_FALSE(region::contains(square, 0.5 * (piece[i] + piece[i - 1])));
+    for (size_t i = 1; i < piece.size(); ++i) EXPECT_FALSE(region::contains(square, 0.5 * (piece[i] + piece[i - 1])));
   }
   EXPECT_NEAR(length, kRemaining, 1e-3);
 }
@@ -232,8 +246,8 @@ TEST(RegionClipLines, LineOutsideIsKeptWhole) {
 }
 
 TEST(RegionContains, HoleIsOutside) {
-  const region::Paths frame = region::subtract(region::rectangle({0, 0}, {1, 0}, 10, 10),
-                                               region::rectangle({0, 0}, {1, 0}, 5, 5));
+  const region::Paths frame =
+      region::subtract(region::rectangle({0, 0}, {1, 0}, 10, 10), region::rectangle({0, 0}, {1, 0}, 5, 5));
   EXPECT_NEAR(region::area(frame), 400 - 100, 1e-9);
   EXPECT_FALSE(region::contains(frame, {0, 0}));
   EXPECT_TRUE(region::contains(frame, {7.5, 0}));

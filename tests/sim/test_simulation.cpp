@@ -4,8 +4,8 @@
 #include <tbb/global_control.h>
 
 #include "sim/simulation.hpp"
-#include "test_support.hpp"
 #include "sim/world_assets.hpp"
+#include "test_support.hpp"
 
 namespace lidarloop {
 namespace {
@@ -25,9 +25,8 @@ struct Recorder : StreamSink {
 // Runs a scenario given as YAML on a world given by name or as YAML text.
 Recorder simulate(const std::string& scenario_yaml, const std::string& world_yaml = "", int threads = 0) {
   const Scenario scenario = parse_scenario(scenario_yaml, "test_scenario.yaml");
-  const WorldDescription description = world_yaml.empty()
-                                           ? load_world_description(world_file(scenario.world))
-                                           : parse_world_description(world_yaml, "test_world.yaml");
+  const WorldDescription description = world_yaml.empty() ? load_world_description(world_file(scenario.world))
+                                                          : parse_world_description(world_yaml, "test_world.yaml");
   const World world = build_world(description, test::materials(), test::data_path("assets/actors"));
   Simulation sim(scenario, description, world, test::materials(), test::data_path("assets/actors"), threads);
   Recorder rec;

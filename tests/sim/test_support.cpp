@@ -12,8 +12,9 @@ const MaterialTable& materials() {
 TriangleMesh flat_ground(float half_size, const std::string& material, float z) {
   TriangleMesh mesh;
   const MaterialId m = materials().id(material, "test");
-  add_flat_quad(mesh, {Eigen::Vector2f(-half_size, -half_size), Eigen::Vector2f(half_size, -half_size),
-                       Eigen::Vector2f(half_size, half_size), Eigen::Vector2f(-half_size, half_size)},
+  add_flat_quad(mesh,
+                {Eigen::Vector2f(-half_size, -half_size), Eigen::Vector2f(half_size, -half_size),
+                 Eigen::Vector2f(half_size, half_size), Eigen::Vector2f(-half_size, half_size)},
                 z, m);
   return mesh;
 }

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <functional>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include "sim/vehicle_model.hpp"
 #include "test_support.hpp"
@@ -12,8 +12,8 @@
 namespace lidarloop {
 namespace {
 
-constexpr double kStep = 1e-3;             // s, the default integration step
-constexpr int64_t kControlNs = 10'000'000; // commands held for 10 ms, as the simulation's controller does
+constexpr double kStep = 1e-3;              // s, the default integration step
+constexpr int64_t kControlNs = 10'000'000;  // commands held for 10 ms, as the simulation's controller does
 
 // Table I of the paper, written out here so the defaults are checked against the source, not themselves.
 constexpr double kTableStiffness = 45980, kTableLf = 1.4, kTableLr = 1.2, kTableIz = 6000, kTableMass = 2300;
@@ -82,10 +82,14 @@ TEST_P(VehicleSteadyTurn, RadiusMatchesSingleTrackClosedForm) {
   VehicleModel car(params, VehicleModel::state_at(params, {}, speed));
   constexpr double kSettle = 20, kFitted = 10;  // s: transient (lags, yaw dynamics), then the fitted arc
   std::vector<Eigen::Vector2d> arc;
-  drive(car, kSettle + kFitted, [&](double, const VehicleState&) { return VehicleCommand{steer, 0}; },
-        [&](double t) {
-          if (t > kSettle) arc.emplace_back(car.state().x, car.state().y);
-        });
+  drive(
+      car, kSettle + kFitted,
+      [&](double, const VehicleState&) {
+        return VehicleCommand{steer, 0};
+      },
+      [&](double t) {
+        if (t > kSettle) arc.emplace_back(car.state().x, car.state().y);
+      });
   ASSERT_DOUBLE_EQ(car.state().vx, speed);  // accel command 0 from rest of the actuator: speed held exactly
 
   const double truth = (kTableLf + kTableLr + table_understeer_gradient() * speed * speed) / steer;
@@ -212,13 +216,18 @@ TEST(VehicleActuators, SteeringIsLaggedRateLimitedAndClamped) {
   // The lag approaches max_steer exponentially once its rate falls below the limit: "reached" = within 1 mrad.
   constexpr double kReached = 1e-3;
   double reached_at = -1, max_change = 0, max_steer = 0, previous = 0;
-  drive(car, 3, [](double, const VehicleState&) { return VehicleCommand{1.0, 0}; }, [&](double t) {
-    const double steer = car.state().steer;
-    max_change = std::max(max_change, std::abs(steer - previous));
-    max_steer = std::max(max_steer, steer);
-    if (reached_at < 0 && steer >= params.max_steer - kReached) reached_at = t;
-    previous = steer;
-  });
+  drive(
+      car, 3,
+      [](double, const VehicleState&) {
+        return VehicleCommand{1.0, 0};
+      },
+      [&](double t) {
+        const double steer = car.state().steer;
+        max_change = std::max(max_change, std::abs(steer - previous));
+        max_steer = std::max(max_steer, steer);
+        if (reached_at < 0 && steer >= params.max_steer - kReached) reached_at = t;
+        previous = steer;
+      });
   EXPECT_LE(max_change, params.max_steer_rate * kStep * (1 + 1e-12));
   EXPECT_LE(max_steer, params.max_steer);
   ASSERT_GT(reached_at, 0) << "never reached max_steer";
@@ -237,18 +246,27 @@ TEST(VehicleActuators, AccelerationIsLaggedAndClampedAndSpeedStaysInRange) {
   {
     VehicleModel car(params, VehicleModel::state_at(params, {}, 10));
     double highest = 0;
-    drive(car, 3, [](double, const VehicleState&) { return VehicleCommand{0, 100}; },
-          [&](double) { highest = std::max(highest, car.state().accel); });
+    drive(
+        car, 3,
+        [](double, const VehicleState&) {
+          return VehicleCommand{0, 100};
+        },
+        [&](double) { highest = std::max(highest, car.state().accel); });
     EXPECT_LE(highest, params.max_accel);
     EXPECT_NEAR(car.state().accel, params.max_accel, 1e-4);
   }
   {
     VehicleModel car(params, VehicleModel::state_at(params, {}, 20));
     double lowest = 0, slowest = 20;
-    drive(car, 5, [](double, const VehicleState&) { return VehicleCommand{0, -100}; }, [&](double) {
-      lowest = std::min(lowest, car.state().accel);
-      slowest = std::min(slowest, car.state().vx);
-    });
+    drive(
+        car, 5,
+        [](double, const VehicleState&) {
+          return VehicleCommand{0, -100};
+        },
+        [&](double) {
+          lowest = std::min(lowest, car.state().accel);
+          slowest = std::min(slowest, car.state().vx);
+        });
     EXPECT_GE(lowest, -params.max_decel);
     EXPECT_LT(lowest, -params.max_decel + 1e-3);  // full braking was reached before the stop
     EXPECT_EQ(slowest, 0.0);
@@ -257,8 +275,12 @@ TEST(VehicleActuators, AccelerationIsLaggedAndClampedAndSpeedStaysInRange) {
   {
     VehicleModel car(params, VehicleModel::state_at(params, {}, 20));
     double fastest = 0;
-    drive(car, 10, [](double, const VehicleState&) { return VehicleCommand{0, 100}; },
-          [&](double) { fastest = std::max(fastest, car.state().vx); });
+    drive(
+        car, 10,
+        [](double, const VehicleState&) {
+          return VehicleCommand{0, 100};
+        },
+        [&](double) { fastest = std::max(fastest, car.state().vx); });
     EXPECT_EQ(fastest, params.max_speed);
     EXPECT_EQ(car.state().vx, params.max_speed);
     EXPECT_EQ(car.state().accel, 0.0);

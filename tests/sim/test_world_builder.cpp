@@ -113,7 +113,7 @@ TEST(WorldBuilder, StraightRoadCarriagewayAndCurbRing) {
   // tolerance) leaves a cut ~15 cm long and under 1 cm deep, shortening the ring by ~1 cm per corner.
   constexpr double kCornerTolerance = 0.01, kPerimeterTolerance = 0.1;
   for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, -kWidth / 2), Eigen::Vector2d(kLength, -kWidth / 2),
-                                       Eigen::Vector2d(kLength, kWidth / 2), Eigen::Vector2d(0, kWidth / 2)})
+                                        Eigen::Vector2d(kLength, kWidth / 2), Eigen::Vector2d(0, kWidth / 2)})
     EXPECT_LT(distance_to_polyline(ring, corner), kCornerTolerance) << corner.transpose();
   EXPECT_NEAR(polyline_length(ring), 2 * (kLength + kWidth), kPerimeterTolerance);
 }
@@ -135,10 +135,10 @@ TEST(WorldBuilder, TIntersectionHasRoundedCorners) {
   // Road b leaves road a at a right angle: one carriageway whose two inner corners are filled with
   // fillets of the corner radius, so its area is the union of the strips + 2 r^2 (1 - pi/4).
   constexpr double kRadius = 6.0, kStemEnd = 60.0, kStemX = 50.0;
-  const World w = test::world_from_yaml(kHeader + "geometry: {corner_radius: " + num(kRadius) + "}\nroads:\n" +
-                                        "  - {name: a, points: [[0, 0], [" + num(kLength) + ", 0]], width: " +
-                                        num(kWidth) + "}\n  - {name: b, points: [[" + num(kStemX) + ", 0], [" +
-                                        num(kStemX) + ", " + num(kStemEnd) + "]], width: " + num(kWidth) + "}\n");
+  const World w = test::world_from_yaml(
+      kHeader + "geometry: {corner_radius: " + num(kRadius) + "}\nroads:\n" + "  - {name: a, points: [[0, 0], [" +
+      num(kLength) + ", 0]], width: " + num(kWidth) + "}\n  - {name: b, points: [[" + num(kStemX) + ", 0], [" +
+      num(kStemX) + ", " + num(kStemEnd) + "]], width: " + num(kWidth) + "}\n");
   ASSERT_EQ(w.carriageway.size(), 1u) << "one region, no holes";
   EXPECT_EQ(w.curbs.size(), 1u);
   const double strips = kLength * kWidth + kWidth * (kStemEnd - kWidth / 2);
@@ -160,7 +160,8 @@ TEST(WorldBuilder, CurbFacesRiseFromAsphaltToCurbHeight) {
   double face_length = 0;
   for (size_t i : faces) {
     float lo = INFINITY, hi = -INFINITY;
-    for (uint32_t v : w.mesh.triangles[i]) lo = std::min(lo, w.mesh.vertices[v].z()), hi = std::max(hi, w.mesh.vertices[v].z());
+    for (uint32_t v : w.mesh.triangles[i])
+      lo = std::min(lo, w.mesh.vertices[v].z()), hi = std::max(hi, w.mesh.vertices[v].z());
     EXPECT_EQ(lo, 0.0f) << "curb face " << i;
     EXPECT_EQ(hi, float(kCurbHeight)) << "curb face " << i;
     face_length += triangle_normal(w.mesh, i).norm() / kCurbHeight;  // 2 x area / height = base length
@@ -171,8 +172,8 @@ TEST(WorldBuilder, CurbFacesRiseFromAsphaltToCurbHeight) {
 
 TEST(WorldBuilder, CurbFacesFaceTheCarriageway) {
   // Each face's outward normal points into the carriageway (the side a LiDAR on the road sees).
-  const World w = test::world_from_yaml(kHeader + "roads:\n  - {name: main, points: [[0, 0], [" + num(kLength) +
-                                        ", 0]]}\n");
+  const World w =
+      test::world_from_yaml(kHeader + "roads:\n  - {name: main, points: [[0, 0], [" + num(kLength) + ", 0]]}\n");
   const std::vector<size_t> faces = curb_faces(w.mesh);
   ASSERT_FALSE(faces.empty());
   for (size_t i : faces) {
@@ -239,8 +240,9 @@ TEST(WorldBuilder, BuildingBesideTheSidewalkBuilds) {
 
 TEST(WorldBuilder, BuildingOnTheCarriagewayIsAnError) {
   // The second building (line 7; column 5 is its opening brace) is the one on the road.
-  expect_build_error(road_with("buildings:\n  - {centre: [50, 12], size: [10, 4]}\n  - {centre: [50, 2], size: [10, 10]}\n"),
-                     "w.yaml:7:5", "building overlaps the road or its sidewalks");
+  expect_build_error(
+      road_with("buildings:\n  - {centre: [50, 12], size: [10, 4]}\n  - {centre: [50, 2], size: [10, 10]}\n"),
+      "w.yaml:7:5", "building overlaps the road or its sidewalks");
 }
 
 TEST(WorldBuilder, BuildingOnTheSidewalkIsAnError) {
@@ -370,8 +372,8 @@ TEST_F(WorldBuilderCampus, SmoothedRoadCornersAreRounded) {
 
 TEST_F(WorldBuilderCampus, HasAllSurfaceMaterials) {
   const std::set<MaterialId> used(world().mesh.materials.begin(), world().mesh.materials.end());
-  for (const char* name : {"asphalt", "lane_paint", "crosswalk_paint", "curb_concrete", "sidewalk", "grass",
-                           "building", "vegetation", "retro_reflector", "metal"})
+  for (const char* name : {"asphalt", "lane_paint", "crosswalk_paint", "curb_concrete", "sidewalk", "grass", "building",
+                           "vegetation", "retro_reflector", "metal"})
     EXPECT_TRUE(used.count(material(name))) << "no " << name << " triangles in the campus mesh";
 }
 

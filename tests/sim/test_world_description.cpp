@@ -155,8 +155,8 @@ TEST(WorldDescription, SmoothedClosedRoadRoundsEveryCorner) {
   for (size_t i = 1; i < r.centreline.size(); ++i) zero_length += (r.centreline[i] - r.centreline[i - 1]).norm() < 1e-6;
   EXPECT_EQ(zero_length, 0) << "zero-length centreline segments";
   // Each corner is R (sqrt 2 - 1) from its arc.
-  for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(100, 0), Eigen::Vector2d(100, 50),
-                                       Eigen::Vector2d(0, 50)}) {
+  for (const Eigen::Vector2d& corner :
+       {Eigen::Vector2d(0, 0), Eigen::Vector2d(100, 0), Eigen::Vector2d(100, 50), Eigen::Vector2d(0, 50)}) {
     double nearest = INFINITY;
     for (const auto& p : r.centreline) nearest = std::min(nearest, (p - corner).norm());
     EXPECT_NEAR(nearest, kRadius * (std::sqrt(2.0) - 1), 0.01) << "corner " << corner.transpose();
