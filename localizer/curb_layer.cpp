@@ -3,28 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include <nanoflann.hpp>
+#include "localizer/points_kd_tree.hpp"
 
 namespace lidarloop {
 
-// nanoflann's dataset interface over the densified points.
-struct PointsAdaptor {
-  const std::vector<Eigen::Vector2d>* points;
-  size_t kdtree_get_point_count() const { return points->size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][int(dim)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-};
-
-struct CurbLayer::Index {
-  PointsAdaptor adaptor;
-  nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor, 2> tree;
-  explicit Index(const std::vector<Eigen::Vector2d>* points)
-      : adaptor{points}, tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
-    tree.buildIndex();
-  }
+struct CurbLayer::Index : PointsKdTree {
+  using PointsKdTree::PointsKdTree;
 };
 
 CurbLayer::CurbLayer(const CurbMap& map, double spacing) : map_(map) {

@@ -4,30 +4,12 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <nanoflann.hpp>
+#include "localizer/points_kd_tree.hpp"
 
 namespace lidarloop {
 
-namespace {
-struct PointsAdaptor {
-  const std::vector<Eigen::Vector2d>* points;
-  size_t kdtree_get_point_count() const { return points->size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][int(dim)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-};
-constexpr int kLeafSize = 16;  // nanoflann's usual trade-off between tree depth and leaf scans
-}  // namespace
-
-struct MapIndex::Tree {
-  PointsAdaptor adaptor;
-  nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor, 2> tree;
-  explicit Tree(const std::vector<Eigen::Vector2d>* points)
-      : adaptor{points}, tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize)) {
-    tree.buildIndex();
-  }
+struct MapIndex::Tree : PointsKdTree {
+  using PointsKdTree::PointsKdTree;
 };
 
 namespace {
