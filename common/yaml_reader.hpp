@@ -1,8 +1,10 @@
 #pragma once
 // Strict reading of YAML files: every error names the file, line and column.
-#include <initializer_list>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Core>
@@ -10,6 +12,9 @@
 #include "common/input_error.hpp"
 
 namespace lidarloop {
+
+// "file:line:col" for a node (1-based), or just the file when the node has no position.
+std::string yaml_location(const std::string& file, const YAML::Node& node);
 
 class YamlReader {
  public:
@@ -26,16 +31,10 @@ class YamlReader {
 
   void expect_map(const YAML::Node& node, std::string_view what) const;
   void expect_sequence(const YAML::Node& node, std::string_view what) const;
-  // Every key of `map` must be one of `allowed`; an unknown key is reported at its own position.
-  void allow_keys(const YAML::Node& map, std::initializer_list<std::string_view> allowed) const;
-  // map[key], or an error at the map's position when it is absent.
-  YAML::Node required(const YAML::Node& map, const std::string& key) const;
 
   double number(const YAML::Node& node, std::string_view what) const;  // finite
   double number_in(const YAML::Node& node, std::string_view what, double lo, double hi) const;
   long integer_in(const YAML::Node& node, std::string_view what, long lo, long hi) const;
-  // Overwrites `value` with map[key] when the key is present (range-checked); keeps it otherwise.
-  void read_number(const YAML::Node& map, const char* key, double& value, double lo, double hi) const;
   bool boolean(const YAML::Node& node, std::string_view what) const;
   std::string string(const YAML::Node& node, std::string_view what) const;
   Eigen::Vector2d vec2(const YAML::Node& node, std::string_view what) const;
@@ -48,7 +47,45 @@ class YamlReader {
   YAML::Node root_;
 };
 
-// "file:line:col" for a node (1-based), or just the file when the node has no position.
-std::string yaml_location(const std::string& file, const YAML::Node& node);
+// One mapping of a YAML file, read key by key. Each read names a key the mapping may hold, so the
+// list of allowed keys is the reads themselves; done() then reports any other key (a typo, a key of
+// another section) at its own line and column. Optional reads overwrite a default only when the key
+// is present, range-checked.
+class YamlMap {
+ public:
+  // An absent `node` (a key not in the file) reads as an empty mapping: every value keeps its default.
+  // Anything else must be a mapping.
+  YamlMap(const YamlReader& reader, const YAML::Node& node, std::string_view what);
+
+  const YamlReader& reader() const { return reader_; }
+  const YAML::Node& node() const { return node_; }
+  bool present() const { return node_.IsDefined(); }
+  std::string where() const { return yaml_location(reader_.file(), node_); }
+
+  // map[key], absent or not; either way `key` is one the mapping may hold.
+  YAML::Node operator[](const char* key);
+  // map[key], or an error at the mapping when it is absent.
+  YAML::Node required(const char* key);
+
+  YamlMap& number(const char* key, double& value, double lo, double hi);
+  YamlMap& number(const char* key, std::optional<double>& value, double lo, double hi);
+  // Written in degrees, kept in radians.
+  YamlMap& degrees(const char* key, double& radians, double lo_deg, double hi_deg);
+  YamlMap& integer(const char* key, int& value, int lo, int hi);
+  YamlMap& integer(const char* key, int64_t& value, int64_t lo, int64_t hi);
+  YamlMap& integer(const char* key, uint64_t& value, uint64_t lo, uint64_t hi);
+  YamlMap& boolean(const char* key, bool& value);
+  YamlMap& string(const char* key, std::string& value);
+  YamlMap& vec2(const char* key, Eigen::Vector2d& value);
+  YamlMap& vec3(const char* key, Eigen::Vector3d& value);
+
+  // Call after the last read: a key no read named is unknown, a key given twice is ambiguous.
+  void done() const;
+
+ private:
+  const YamlReader& reader_;
+  YAML::Node node_;
+  std::vector<std::string> keys_;
+};
 
 }  // namespace lidarloop

@@ -387,51 +387,48 @@ void IntensityMapBuilder::save(const std::string& dir) const {
 
 IntensityMapHeader read_intensity_map_header(const std::string& dir) {
   const YamlReader yaml = YamlReader::open((fs::path(dir) / kHeaderFile).string());
-  const YAML::Node& root = yaml.root();
-  yaml.expect_map(root, "intensity map header");
-  yaml.allow_keys(root, {"format", "version", "world", "world_hash", "origin", "projection", "resolution_m",
-                         "tile_cells", "tile_size_m", "build", "tiles"});
+  YamlMap root(yaml, yaml.root(), "intensity map header");
   IntensityMapHeader h;
 
-  const YAML::Node format = yaml.required(root, "format");
+  const YAML::Node format = root.required("format");
   if (yaml.string(format, "format") != kFormatName)
     yaml.fail(format, "format is '" + format.Scalar() + "', expected '" + kFormatName + "'");
-  const YAML::Node version = yaml.required(root, "version");
+  const YAML::Node version = root.required("version");
   const long v = yaml.integer_in(version, "version", LONG_MIN, LONG_MAX);
   if (v != kFormatVersion)
     yaml.fail(version,
               "unsupported version " + std::to_string(v) + " (expected " + std::to_string(kFormatVersion) + ")");
 
-  h.world = yaml.string(yaml.required(root, "world"), "world");
-  h.world_hash = yaml.string(yaml.required(root, "world_hash"), "world_hash");
+  h.world = yaml.string(root.required("world"), "world");
+  h.world_hash = yaml.string(root.required("world_hash"), "world_hash");
 
-  const YAML::Node origin = yaml.required(root, "origin");
-  yaml.expect_map(origin, "origin");
-  yaml.allow_keys(origin, {"lat", "lon", "alt"});
-  h.origin.lat_deg = yaml.number_in(yaml.required(origin, "lat"), "origin.lat", -kMaxLatitudeDeg, kMaxLatitudeDeg);
-  h.origin.lon_deg = yaml.number_in(yaml.required(origin, "lon"), "origin.lon", -kMaxLongitudeDeg, kMaxLongitudeDeg);
-  h.origin.alt_m = yaml.number(yaml.required(origin, "alt"), "origin.alt");
+  YamlMap origin(yaml, root.required("origin"), "origin");
+  h.origin.lat_deg = yaml.number_in(origin.required("lat"), "origin.lat", -kMaxLatitudeDeg, kMaxLatitudeDeg);
+  h.origin.lon_deg = yaml.number_in(origin.required("lon"), "origin.lon", -kMaxLongitudeDeg, kMaxLongitudeDeg);
+  h.origin.alt_m = yaml.number(origin.required("alt"), "origin.alt");
+  origin.done();
 
-  const YAML::Node projection = yaml.required(root, "projection");
+  const YAML::Node projection = root.required("projection");
   if (yaml.string(projection, "projection") != kProjection)
     yaml.fail(projection, "projection '" + projection.Scalar() + "' is not supported (expected '" + kProjection + "')");
 
-  const YAML::Node resolution = yaml.required(root, "resolution_m");
+  const YAML::Node resolution = root.required("resolution_m");
   h.resolution_m = yaml.number(resolution, "resolution_m");
   if (h.resolution_m <= 0) yaml.fail(resolution, "resolution_m = " + resolution.Scalar() + " must be > 0");
-  h.tile_cells = int(yaml.integer_in(yaml.required(root, "tile_cells"), "tile_cells", kMinTileCells, kMaxTileCells));
-  const YAML::Node tile_size = yaml.required(root, "tile_size_m");
+  h.tile_cells = int(yaml.integer_in(root.required("tile_cells"), "tile_cells", kMinTileCells, kMaxTileCells));
+  const YAML::Node tile_size = root.required("tile_size_m");
   const double size = yaml.number(tile_size, "tile_size_m");
   if (std::fabs(size - h.tile_size_m()) > kTileSizeRelativeTolerance * h.tile_size_m())
     yaml.fail(tile_size, "tile_size_m = " + tile_size.Scalar() +
                              " does not match resolution_m * tile_cells = " + shortest(h.tile_size_m()));
 
-  const YAML::Node build = yaml.required(root, "build");
+  const YAML::Node build = root.required("build");
   yaml.expect_map(build, "build");
   for (const auto& entry : build)
     h.build[yaml.string(entry.first, "build key")] = yaml.string(entry.second, "build value");
 
-  const YAML::Node tiles = yaml.required(root, "tiles");
+  const YAML::Node tiles = root.required("tiles");
+  root.done();
   yaml.expect_sequence(tiles, "tiles");
   std::set<std::pair<int, int>> seen;
   for (const YAML::Node& t : tiles) {

@@ -5,55 +5,8 @@
 namespace lidarloop {
 namespace {
 
-// A section reader: each field read is also an allowed key, so the key list cannot drift from the fields;
-// done() then rejects whatever else the section holds.
-class Section {
- public:
-  Section(const YamlReader& y, const YAML::Node& node, const char* name) : y_(y), node_(node) {
-    if (node_) y_.expect_map(node_, name);
-  }
-  Section& number(const char* key, double& value, double lo, double hi) {
-    keys_.push_back(key);
-    if (node_) y_.read_number(node_, key, value, lo, hi);
-    return *this;
-  }
-  Section& integer(const char* key, int& value, int lo, int hi) {
-    keys_.push_back(key);
-    if (node_ && node_[key]) value = int(y_.integer_in(node_[key], key, lo, hi));
-    return *this;
-  }
-  Section& boolean(const char* key, bool& value) {
-    keys_.push_back(key);
-    if (node_ && node_[key]) value = y_.boolean(node_[key], key);
-    return *this;
-  }
-  Section& section(const char* key) {  // a nested section, read by its own Section
-    keys_.push_back(key);
-    return *this;
-  }
-  // Call last: every key of the section must have been read by now.
-  void done() const {
-    if (!node_) return;
-    for (auto it = node_.begin(); it != node_.end(); ++it) {
-      const std::string key = it->first.as<std::string>();
-      bool known = false;
-      for (const auto& k : keys_) known = known || k == key;
-      if (!known) {
-        std::string list;
-        for (const auto& k : keys_) list += (list.empty() ? "" : ", ") + k;
-        y_.fail(it->first, "unknown key '" + key + "' (expected one of: " + list + ")");
-      }
-    }
-  }
-
- private:
-  const YamlReader& y_;
-  YAML::Node node_;
-  std::vector<std::string> keys_;
-};
-
 void read_icp(const YamlReader& y, const YAML::Node& n, const char* name, IcpParams& p) {
-  Section(y, n, name)
+  YamlMap(y, n, name)
       .integer("max_iterations", p.max_iterations, 1, 1000)
       .number("convergence", p.convergence, 1e-9, 1.0)
       .number("max_correspondence", p.max_correspondence, 0.01, 100.0)
@@ -71,8 +24,8 @@ bool removes_obstacles(LocalizerMethod m) { return m != LocalizerMethod::icp && 
 
 void read_localizer_params(const YamlReader& y, const YAML::Node& node, LocalizerParams& p) {
   if (!node) return;
-  Section top(y, node, "localizer");
-  top.section("method").boolean("deskew", p.deskew).number("map_window_m", p.map_window_m, 5.0, 200.0);
+  YamlMap top(y, node, "localizer");
+  top.boolean("deskew", p.deskew).number("map_window_m", p.map_window_m, 5.0, 200.0);
   top.number("max_prediction_step_s", p.max_prediction_step_s, 1e-4, 0.1);
   top.number("process_position_without_can_per_s", p.process_position_without_can_per_s, 0.0, 100.0);
   top.number("aps_window_sigmas", p.aps_window_sigmas, 0.0, 100.0);
@@ -82,32 +35,28 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   top.number("icp_max_correspondence_m", p.icp_max_correspondence_m, 0.1, 100.0);
   top.number("aps_max_lateral_range_m", p.aps_max_lateral_range_m, 0.0, 50.0);
   top.number("aps_max_longitudinal_range_m", p.aps_max_longitudinal_range_m, 0.0, 50.0);
-  if (const YAML::Node m = node["method"]) {
+  if (const YAML::Node m = top["method"]) {
     try {
       p.method = parse_localizer_method(y.string(m, "method"));
     } catch (const std::invalid_argument& e) {
       y.fail(m, e.what());
     }
   }
-  if (const YAML::Node s = node["seed"]) p.seed = uint64_t(y.integer_in(s, "seed", 0, 1L << 62));
-  top.section("seed");
+  top.integer("seed", p.seed, 0, uint64_t(1) << 62);
 
-  top.section("corridor");
-  Section(y, node["corridor"], "corridor")
+  YamlMap(y, top["corridor"], "corridor")
       .integer("width_cells", p.corridor.width_cells, 10, 4000)
       .integer("height_cells", p.corridor.height_cells, 10, 4000)
       .number("cell_m", p.corridor.cell_m, 0.01, 2.0)
       .integer("dilation_cells", p.corridor.dilation_cells, 0, 50)
       .done();
-  top.section("obstacles");
-  Section(y, node["obstacles"], "obstacles")
+  YamlMap(y, top["obstacles"], "obstacles")
       .number("ground_fraction", p.obstacles.ground_fraction, 0.01, 1.0)
       .number("obstacle_distance", p.obstacles.obstacle_distance, 0.01, 10.0)
       .number("ground_cell_m", p.obstacles.ground_cell_m, 0.05, 20.0)
       .number("ground_refit_distance", p.obstacles.ground_refit_distance, 0.01, 10.0)
       .done();
-  top.section("curb_detector");
-  Section(y, node["curb_detector"], "curb_detector")
+  YamlMap(y, top["curb_detector"], "curb_detector")
       .number("min_height", p.curb_detector.min_height, 0.0, 1.0)
       .number("max_height", p.curb_detector.max_height, 0.01, 2.0)
       .number("step_length", p.curb_detector.step_length, 0.01, 5.0)
@@ -116,43 +65,30 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("max_range", p.curb_detector.max_range, 1.0, 100.0)
       .number("max_ground_height", p.curb_detector.max_ground_height, 0.0, 5.0)
       .done();
-  top.section("curb_features");
-  Section(y, node["curb_features"], "curb_features")
+  YamlMap(y, top["curb_features"], "curb_features")
       .integer("frames", p.curb_features.frames, 1, 100)
       .number("obstacle_distance", p.curb_features.obstacle_distance, 0.0, 10.0)
       .integer("beams", p.curb_features.beams, 1, 3600)
       .number("beam_half_extent", p.curb_features.beam_half_extent, 1.0, 100.0)
       .done();
-  top.section("probabilistic_icp");
   {
-    const YAML::Node n = node["probabilistic_icp"];
-    Section(y, n, "probabilistic_icp")
-        .integer("n_p", p.probabilistic_icp.n_p, 1, 10000)
+    YamlMap picp(y, top["probabilistic_icp"], "probabilistic_icp");
+    picp.integer("n_p", p.probabilistic_icp.n_p, 1, 10000)
         .integer("n_t", p.probabilistic_icp.n_t, 1, 10000)
         .number("d_g", p.probabilistic_icp.d_g, 0.01, 100.0)
-        .number("outlier_softness_curbs", p.probabilistic_icp.outlier_softness_curbs, 0.0, 1000.0)
-        .section("local")
-        .section("global")
-        .done();
-    if (n) {
-      read_icp(y, n["local"], "local", p.probabilistic_icp.local);
-      read_icp(y, n["global"], "global", p.probabilistic_icp.global);
-    }
+        .number("outlier_softness_curbs", p.probabilistic_icp.outlier_softness_curbs, 0.0, 1000.0);
+    read_icp(y, picp["local"], "local", p.probabilistic_icp.local);
+    read_icp(y, picp["global"], "global", p.probabilistic_icp.global);
+    picp.done();
   }
-  top.section("icp");
-  read_icp(y, node["icp"], "icp", p.icp);
-  top.section("m_icp");
+  read_icp(y, top["icp"], "icp", p.icp);
   {
-    const YAML::Node n = node["m_icp"];
-    Section(y, n, "m_icp")
-        .number("biweight_b", p.m_icp.biweight_b, 0.1, 100.0)
-        .number("scale_m", p.m_icp.scale_m, 0.001, 100.0)
-        .section("icp")
-        .done();
-    if (n) read_icp(y, n["icp"], "icp", p.m_icp.icp);
+    YamlMap m_icp(y, top["m_icp"], "m_icp");
+    m_icp.number("biweight_b", p.m_icp.biweight_b, 0.1, 100.0).number("scale_m", p.m_icp.scale_m, 0.001, 100.0);
+    read_icp(y, m_icp["icp"], "icp", p.m_icp.icp);
+    m_icp.done();
   }
-  top.section("fmt");
-  Section(y, node["fmt"], "fmt")
+  YamlMap(y, top["fmt"], "fmt")
       .integer("size_cells", p.fmt.size_cells, 16, 4096)
       .number("cell_m", p.fmt.cell_m, 0.01, 2.0)
       .number("blur_sigma_cells", p.fmt.blur_sigma_cells, 0.0, 20.0)
@@ -162,15 +98,13 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .integer("min_points", p.fmt.min_points, 1, 100000)
       .number("min_response", p.fmt.min_response, 0.0, 1.0)
       .done();
-  top.section("intensity_grid");
-  Section(y, node["intensity_grid"], "intensity_grid")
+  YamlMap(y, top["intensity_grid"], "intensity_grid")
       .integer("width_cells", p.intensity_grid.width_cells, 10, 4000)
       .integer("height_cells", p.intensity_grid.height_cells, 10, 4000)
       .number("cell_m", p.intensity_grid.cell_m, 0.01, 2.0)
       .number("max_height", p.intensity_grid.max_height, 0.01, 10.0)
       .done();
-  top.section("aps");
-  Section(y, node["aps"], "aps")
+  YamlMap(y, top["aps"], "aps")
       .number("lateral_range_m", p.aps.lateral_range_m, 0.0, 20.0)
       .number("longitudinal_range_m", p.aps.longitudinal_range_m, 0.0, 20.0)
       .number("step_m", p.aps.step_m, 0.01, 5.0)
@@ -179,8 +113,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("min_sigma", p.aps.min_sigma, 1e-6, 255.0)
       .integer("min_cells", p.aps.min_cells, 0, 1000000)
       .done();
-  top.section("vehicle");
-  Section(y, node["vehicle"], "vehicle")
+  YamlMap(y, top["vehicle"], "vehicle")
       .number("cornering_stiffness_front", p.vehicle.cornering_stiffness_front, 1e3, 1e6)
       .number("cornering_stiffness_rear", p.vehicle.cornering_stiffness_rear, 1e3, 1e6)
       .number("lf", p.vehicle.lf, 0.1, 10.0)
@@ -190,28 +123,24 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("steering_ratio", p.vehicle.steering_ratio, 1.0, 50.0)
       .number("kinematic_below", p.vehicle.kinematic_below, 0.0, 10.0)
       .done();
-  top.section("filter");
-  Section(y, node["filter"], "filter")
+  YamlMap(y, top["filter"], "filter")
       .number("position_per_sqrt_m", p.filter.position_per_sqrt_m, 0.0, 10.0)
       .number("yaw_per_sqrt_m", p.filter.yaw_per_sqrt_m, 0.0, 1.0)
       .number("position_per_sqrt_s", p.filter.position_per_sqrt_s, 0.0, 10.0)
       .done();
-  top.section("curb_noise");
-  Section(y, node["curb_noise"], "curb_noise")
+  YamlMap(y, top["curb_noise"], "curb_noise")
       .number("point_sigma_m", p.curb_noise.point_sigma_m, 1e-4, 10.0)
       .number("inlier_distance_m", p.curb_noise.inlier_distance_m, 0.01, 100.0)
       .number("min_sigma_m", p.curb_noise.min_sigma_m, 0.0, 10.0)
       .number("min_sigma_yaw_rad", p.curb_noise.min_sigma_yaw_rad, 0.0, 1.0)
       .number("unconstrained_sigma_m", p.curb_noise.unconstrained_sigma_m, 1.0, 1e6)
       .done();
-  top.section("gps_noise");
-  Section(y, node["gps_noise"], "gps_noise")
+  YamlMap(y, top["gps_noise"], "gps_noise")
       .number("min_sigma_m", p.gps_noise.min_sigma_m, 0.0, 100.0)
       .number("min_heading_sigma_rad", p.gps_noise.min_heading_sigma_rad, 0.0, 3.2)
       .number("variance_scale", p.gps_noise.variance_scale, 1e-3, 1e6)
       .done();
-  top.section("health");
-  Section(y, node["health"], "health")
+  YamlMap(y, top["health"], "health")
       .number("gps_timeout_s", p.health.gps_timeout_s, 0.01, 1e4)
       .number("can_timeout_s", p.health.can_timeout_s, 0.001, 1e4)
       .integer("min_scan_points", p.health.min_scan_points, 0, 10000000)

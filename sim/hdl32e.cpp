@@ -30,37 +30,12 @@ Eigen::Isometry3d Hdl32eConfig::mount() const {
 }
 
 void read_hdl32e_config(const YamlReader& y, const YAML::Node& n, Hdl32eConfig& c) {
-  y.expect_map(n, "lidar");
-  y.allow_keys(n, {"elevation_deg",
-                   "firing_order",
-                   "firing_period_ns",
-                   "slots_per_cycle",
-                   "rotation_hz",
-                   "scan_start_yaw_deg",
-                   "min_range_m",
-                   "max_range_m",
-                   "range_resolution_m",
-                   "range_noise_m",
-                   "dark_target_reflectivity",
-                   "dark_target_range_m",
-                   "detection_incidence_exponent",
-                   "detection_softness",
-                   "max_incidence_deg",
-                   "intensity_incidence_exponent",
-                   "intensity_reference_range_m",
-                   "intensity_range_exponent",
-                   "intensity_noise",
-                   "laser_gain_spread",
-                   "unit_serial",
-                   "mount_xyz",
-                   "mount_rpy_deg",
-                   "motion_distortion",
-                   "cycles_per_actor_update"});
-  if (const YAML::Node e = n["elevation_deg"]) {
+  YamlMap m(y, n, "lidar");
+  if (const YAML::Node e = m["elevation_deg"]) {
     if (!e.IsSequence() || e.size() != kHdl32eLasers) y.fail(e, "elevation_deg must list 32 elevations");
     for (int i = 0; i < kHdl32eLasers; ++i) c.elevation_deg[i] = y.number_in(e[i], "elevation_deg", -90.0, 90.0);
   }
-  if (const YAML::Node o = n["firing_order"]) {
+  if (const YAML::Node o = m["firing_order"]) {
     if (!o.IsSequence() || o.size() != kHdl32eLasers) y.fail(o, "firing_order must list 32 ring indices");
     std::array<bool, kHdl32eLasers> seen{};
     for (int i = 0; i < kHdl32eLasers; ++i) {
@@ -69,31 +44,30 @@ void read_hdl32e_config(const YamlReader& y, const YAML::Node& n, Hdl32eConfig& 
       seen[c.firing_order[i]] = true;
     }
   }
-  if (n["firing_period_ns"]) c.firing_period_ns = y.integer_in(n["firing_period_ns"], "firing_period_ns", 100, 100000);
-  if (n["slots_per_cycle"])
-    c.slots_per_cycle = int(y.integer_in(n["slots_per_cycle"], "slots_per_cycle", kHdl32eLasers, 1000));
-  y.read_number(n, "rotation_hz", c.rotation_hz, 5.0, 20.0);
-  y.read_number(n, "scan_start_yaw_deg", c.scan_start_yaw_deg, -360.0, 360.0);
-  y.read_number(n, "min_range_m", c.min_range_m, 0.0, 10.0);
-  y.read_number(n, "max_range_m", c.max_range_m, 1.0, 300.0);
-  y.read_number(n, "range_resolution_m", c.range_resolution_m, 0.0, 0.1);
-  y.read_number(n, "range_noise_m", c.range_noise_m, 0.0, 1.0);
-  y.read_number(n, "dark_target_reflectivity", c.dark_target_reflectivity, 0.001, 1.0);
-  y.read_number(n, "dark_target_range_m", c.dark_target_range_m, 1.0, 1000.0);
-  y.read_number(n, "detection_incidence_exponent", c.detection_incidence_exponent, 0.0, 4.0);
-  y.read_number(n, "detection_softness", c.detection_softness, 0.0, 2.0);
-  y.read_number(n, "max_incidence_deg", c.max_incidence_deg, 0.0, 90.0);
-  y.read_number(n, "intensity_incidence_exponent", c.intensity_incidence_exponent, 0.0, 4.0);
-  y.read_number(n, "intensity_reference_range_m", c.intensity_reference_range_m, 0.1, 1000.0);
-  y.read_number(n, "intensity_range_exponent", c.intensity_range_exponent, 0.0, 4.0);
-  y.read_number(n, "intensity_noise", c.intensity_noise, 0.0, 50.0);
-  y.read_number(n, "laser_gain_spread", c.laser_gain_spread, 0.0, 0.5);
-  if (n["unit_serial"]) c.unit_serial = uint64_t(y.integer_in(n["unit_serial"], "unit_serial", 0, 1L << 40));
-  if (n["mount_xyz"]) c.mount_xyz = y.vec3(n["mount_xyz"], "mount_xyz");
-  if (n["mount_rpy_deg"]) c.mount_rpy_deg = y.vec3(n["mount_rpy_deg"], "mount_rpy_deg");
-  if (n["motion_distortion"]) c.motion_distortion = y.boolean(n["motion_distortion"], "motion_distortion");
-  if (n["cycles_per_actor_update"])
-    c.cycles_per_actor_update = int(y.integer_in(n["cycles_per_actor_update"], "cycles_per_actor_update", 1, 10000));
+  m.integer("firing_period_ns", c.firing_period_ns, 100, 100000)
+      .integer("slots_per_cycle", c.slots_per_cycle, kHdl32eLasers, 1000)
+      .number("rotation_hz", c.rotation_hz, 5.0, 20.0)
+      .number("scan_start_yaw_deg", c.scan_start_yaw_deg, -360.0, 360.0)
+      .number("min_range_m", c.min_range_m, 0.0, 10.0)
+      .number("max_range_m", c.max_range_m, 1.0, 300.0)
+      .number("range_resolution_m", c.range_resolution_m, 0.0, 0.1)
+      .number("range_noise_m", c.range_noise_m, 0.0, 1.0)
+      .number("dark_target_reflectivity", c.dark_target_reflectivity, 0.001, 1.0)
+      .number("dark_target_range_m", c.dark_target_range_m, 1.0, 1000.0)
+      .number("detection_incidence_exponent", c.detection_incidence_exponent, 0.0, 4.0)
+      .number("detection_softness", c.detection_softness, 0.0, 2.0)
+      .number("max_incidence_deg", c.max_incidence_deg, 0.0, 90.0)
+      .number("intensity_incidence_exponent", c.intensity_incidence_exponent, 0.0, 4.0)
+      .number("intensity_reference_range_m", c.intensity_reference_range_m, 0.1, 1000.0)
+      .number("intensity_range_exponent", c.intensity_range_exponent, 0.0, 4.0)
+      .number("intensity_noise", c.intensity_noise, 0.0, 50.0)
+      .number("laser_gain_spread", c.laser_gain_spread, 0.0, 0.5)
+      .integer("unit_serial", c.unit_serial, 0, uint64_t(1) << 40)
+      .vec3("mount_xyz", c.mount_xyz)
+      .vec3("mount_rpy_deg", c.mount_rpy_deg)
+      .boolean("motion_distortion", c.motion_distortion)
+      .integer("cycles_per_actor_update", c.cycles_per_actor_update, 1, 10000)
+      .done();
   if (c.min_range_m >= c.max_range_m) y.fail(n, "min_range_m must be below max_range_m");
 }
 

@@ -8,19 +8,20 @@ namespace lidarloop {
 
 MaterialTable MaterialTable::load(const std::string& path) {
   const YamlReader yaml = YamlReader::open(path);
-  yaml.expect_map(yaml.root(), "the materials file");
-  yaml.allow_keys(yaml.root(), {"materials"});
-  const YAML::Node list = yaml.required(yaml.root(), "materials");
+  YamlMap file(yaml, yaml.root(), "the materials file");
+  const YAML::Node list = file.required("materials");
+  file.done();
   yaml.expect_map(list, "materials");
   MaterialTable table;
   table.file_ = path;
   for (const auto& entry : list) {
-    yaml.expect_map(entry.second, "material '" + entry.first.Scalar() + "'");
-    yaml.allow_keys(entry.second, {"reflectivity", "retro", "description"});
+    YamlMap material(yaml, entry.second, "material '" + entry.first.Scalar() + "'");
     Material m;
     m.name = entry.first.Scalar();
-    m.reflectivity = yaml.number_in(yaml.required(entry.second, "reflectivity"), "reflectivity", 0.0, 1.0);
-    if (entry.second["retro"]) m.retro = yaml.boolean(entry.second["retro"], "retro");
+    m.reflectivity = yaml.number_in(material.required("reflectivity"), "reflectivity", 0.0, 1.0);
+    material.boolean("retro", m.retro);
+    material["description"];  // for the reader of the file only
+    material.done();
     if (table.contains(m.name)) yaml.fail(entry.first, "material '" + m.name + "' is defined twice");
     table.materials_.push_back(m);
   }

@@ -80,35 +80,29 @@ double understeer_gradient(const VehicleParams& p) {
 }  // namespace
 
 void read_vehicle_params(const YamlReader& y, const YAML::Node& n, VehicleParams& p) {
-  y.expect_map(n, "vehicle");
-  y.allow_keys(
-      n, {"cornering_stiffness_front", "cornering_stiffness_rear", "lf", "lr", "yaw_inertia", "mass", "steering_ratio",
-          "wheel_radius", "track_width", "max_steer", "max_steer_rate", "steer_time_constant", "max_accel", "max_decel",
-          "accel_time_constant", "max_speed", "kinematic_below", "step_ns"});
+  YamlMap m(y, n, "vehicle");
   // Ranges: what a road vehicle from a small car to a loaded truck can have.
-  y.read_number(n, "cornering_stiffness_front", p.cornering_stiffness_front, 1e3, 1e6);
-  y.read_number(n, "cornering_stiffness_rear", p.cornering_stiffness_rear, 1e3, 1e6);
-  y.read_number(n, "lf", p.lf, 0.0, 10.0);
-  y.read_number(n, "lr", p.lr, 0.0, 10.0);
-  y.read_number(n, "yaw_inertia", p.yaw_inertia, 100.0, 1e6);
-  y.read_number(n, "mass", p.mass, 100.0, 1e5);
-  y.read_number(n, "steering_ratio", p.steering_ratio, 1.0, 50.0);
-  y.read_number(n, "wheel_radius", p.wheel_radius, 0.1, 2.0);
-  y.read_number(n, "track_width", p.track_width, 0.5, 4.0);
-  y.read_number(n, "max_steer", p.max_steer, 0.01,
-                1.2);  // below pi/2, where tan(delta) of the kinematic model blows up
-  y.read_number(n, "max_steer_rate", p.max_steer_rate, 0.01, 10.0);
-  y.read_number(n, "steer_time_constant", p.steer_time_constant, 0.0, 2.0);
-  y.read_number(n, "max_accel", p.max_accel, 0.1, 20.0);
-  y.read_number(n, "max_decel", p.max_decel, 0.1, 20.0);
-  y.read_number(n, "accel_time_constant", p.accel_time_constant, 0.0, 2.0);
-  y.read_number(n, "max_speed", p.max_speed, 0.5, 100.0);
-  y.read_number(n, "kinematic_below", p.kinematic_below, kBlendWidth, 10.0);  // keeps Eq. 19 away from vx = 0
-  if (n["step_ns"]) {
-    p.step_ns = y.integer_in(n["step_ns"], "step_ns", kMinStepNs, kMaxStepNs);
-    // The simulation samples controller and sensors on whole milliseconds: they must fall on steps.
-    if (kMaxStepNs % p.step_ns != 0) y.fail(n["step_ns"], "step_ns must divide 1 ms (1000000) evenly");
-  }
+  m.number("cornering_stiffness_front", p.cornering_stiffness_front, 1e3, 1e6)
+      .number("cornering_stiffness_rear", p.cornering_stiffness_rear, 1e3, 1e6)
+      .number("lf", p.lf, 0.0, 10.0)
+      .number("lr", p.lr, 0.0, 10.0)
+      .number("yaw_inertia", p.yaw_inertia, 100.0, 1e6)
+      .number("mass", p.mass, 100.0, 1e5)
+      .number("steering_ratio", p.steering_ratio, 1.0, 50.0)
+      .number("wheel_radius", p.wheel_radius, 0.1, 2.0)
+      .number("track_width", p.track_width, 0.5, 4.0)
+      .number("max_steer", p.max_steer, 0.01, 1.2)  // below pi/2, where tan(delta) of the kinematic model blows up
+      .number("max_steer_rate", p.max_steer_rate, 0.01, 10.0)
+      .number("steer_time_constant", p.steer_time_constant, 0.0, 2.0)
+      .number("max_accel", p.max_accel, 0.1, 20.0)
+      .number("max_decel", p.max_decel, 0.1, 20.0)
+      .number("accel_time_constant", p.accel_time_constant, 0.0, 2.0)
+      .number("max_speed", p.max_speed, 0.5, 100.0)
+      .number("kinematic_below", p.kinematic_below, kBlendWidth, 10.0)  // keeps Eq. 19 away from vx = 0
+      .integer("step_ns", p.step_ns, kMinStepNs, kMaxStepNs)
+      .done();
+  // The simulation samples controller and sensors on whole milliseconds: they must fall on steps.
+  if (kMaxStepNs % p.step_ns != 0) y.fail(n["step_ns"], "step_ns must divide 1 ms (1000000) evenly");
 
   if (p.wheelbase() <= 0) y.fail(n["lf"] ? n["lf"] : n["lr"] ? n["lr"] : n, "lf + lr (the wheelbase) must be > 0");
   const double k = understeer_gradient(p);

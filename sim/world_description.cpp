@@ -31,28 +31,27 @@ RoadSide read_side(const YamlReader& y, const YAML::Node& n) {
 }
 
 // Road properties that may appear both in road_defaults and on each road.
-void read_road_properties(const YamlReader& y, const YAML::Node& n, RoadSpec& road) {
-  if (n["width"]) road.width = y.number_in(n["width"], "width", 2.5, 40.0);
-  if (n["lanes"]) road.lanes = static_cast<int>(y.integer_in(n["lanes"], "lanes", 1, 8));
-  if (n["one_way"]) road.one_way = y.boolean(n["one_way"], "one_way");
-  if (n["marking"]) road.marking = read_marking(y, n["marking"]);
-  if (n["edge_lines"]) road.edge_lines = y.boolean(n["edge_lines"], "edge_lines");
-  if (n["curb_height"]) road.curb_height = y.number_in(n["curb_height"], "curb_height", 0.05, 0.30);
-  if (n["sidewalk_width"]) road.sidewalk_width = y.number_in(n["sidewalk_width"], "sidewalk_width", 0.0, 15.0);
-  if (n["smoothing_radius"]) road.smoothing_radius = y.number_in(n["smoothing_radius"], "smoothing_radius", 0.0, 500.0);
+void read_road_properties(YamlMap& m, RoadSpec& road) {
+  const YamlReader& y = m.reader();
+  m.number("width", road.width, 2.5, 40.0)
+      .integer("lanes", road.lanes, 1, 8)
+      .boolean("one_way", road.one_way)
+      .boolean("edge_lines", road.edge_lines)
+      .number("curb_height", road.curb_height, 0.05, 0.30)
+      .number("sidewalk_width", road.sidewalk_width, 0.0, 15.0)
+      .number("smoothing_radius", road.smoothing_radius, 0.0, 500.0);
+  if (const YAML::Node marking = m["marking"]) road.marking = read_marking(y, marking);
 }
-#define ROAD_PROPERTY_KEYS \
-  "width", "lanes", "one_way", "marking", "edge_lines", "curb_height", "sidewalk_width", "smoothing_radius"
 
 RoadSpec read_road(const YamlReader& y, const YAML::Node& n, const RoadSpec& defaults) {
-  y.expect_map(n, "a road");
-  y.allow_keys(n, {"name", "points", "closed", ROAD_PROPERTY_KEYS});
+  YamlMap m(y, n, "a road");
   RoadSpec road = defaults;
-  road.where = yaml_location(y.file(), n);
-  road.name = y.string(y.required(n, "name"), "road name");
-  read_road_properties(y, n, road);
-  if (n["closed"]) road.closed = y.boolean(n["closed"], "closed");
-  const YAML::Node points = y.required(n, "points");
+  road.where = m.where();
+  road.name = y.string(m.required("name"), "road name");
+  read_road_properties(m, road);
+  m.boolean("closed", road.closed);
+  const YAML::Node points = m.required("points");
+  m.done();
   y.expect_sequence(points, "points");
   for (const auto& p : points) road.points.push_back(y.vec2(p, "a road point"));
   if (road.points.size() < (road.closed ? 3u : 2u))
@@ -77,33 +76,37 @@ RoadSpec read_road(const YamlReader& y, const YAML::Node& n, const RoadSpec& def
   return road;
 }
 
-void read_row(const YamlReader& y, const YAML::Node& n, RowSpec& row) {
-  row.where = yaml_location(y.file(), n);
-  row.road = y.string(y.required(n, "road"), "road");
-  if (n["side"]) row.side = read_side(y, n["side"]);
-  if (n["spacing"]) row.spacing = y.number_in(n["spacing"], "spacing", 2.0, 1000.0);
-  if (n["setback"]) row.setback = y.number_in(n["setback"], "setback", 0.0, 50.0);
-  if (n["start"]) row.start = y.number_in(n["start"], "start", 0.0, 1e5);
+void read_row(YamlMap& m, RowSpec& row) {
+  row.where = m.where();
+  row.road = m.reader().string(m.required("road"), "road");
+  if (const YAML::Node side = m["side"]) row.side = read_side(m.reader(), side);
+  m.number("spacing", row.spacing, 2.0, 1000.0)
+      .number("setback", row.setback, 0.0, 50.0)
+      .number("start", row.start, 0.0, 1e5);
 }
 
 // A position along a road: `at` (arc length along its centreline) or `near: [x, y]` (projected onto it).
-double read_station(const YamlReader& y, const YAML::Node& n, const WorldDescription& w, const std::string& road) {
-  if (n["at"] && n["near"]) y.fail(n, "give either 'at' or 'near', not both");
-  if (n["at"]) return y.number_in(n["at"], "at", 0.0, 1e5);
-  if (!n["near"]) y.fail(n, "missing key 'at' (arc length along the road) or 'near' ([x, y])");
+double read_station(YamlMap& m, const WorldDescription& w, const std::string& road) {
+  const YamlReader& y = m.reader();
+  const YAML::Node at = m["at"], near = m["near"];
+  if (at && near) y.fail(m.node(), "give either 'at' or 'near', not both");
+  if (at) return y.number_in(at, "at", 0.0, 1e5);
+  if (!near) y.fail(m.node(), "missing key 'at' (arc length along the road) or 'near' ([x, y])");
   const RoadSpec* r = w.road(road);
-  if (!r) y.fail(n["road"], "unknown road '" + road + "'");
-  return project_onto_polyline(r->centreline, y.vec2(n["near"], "near"));
+  if (!r) y.fail(m.node()["road"], "unknown road '" + road + "'");
+  return project_onto_polyline(r->centreline, y.vec2(near, "near"));
 }
 
+// Each entry of root[key] is a mapping, read by `read` and then checked for keys it did not read.
 template <class Item, class Read>
-void read_list(const YamlReader& y, const YAML::Node& root, const char* key, std::vector<Item>& out, Read read) {
+void read_list(YamlMap& root, const char* key, std::vector<Item>& out, Read read) {
   const YAML::Node list = root[key];
   if (!list) return;
-  y.expect_sequence(list, key);
+  root.reader().expect_sequence(list, key);
   for (const auto& n : list) {
-    y.expect_map(n, std::string("an entry of ") + key);
-    out.push_back(read(n));
+    YamlMap m(root.reader(), n, std::string("an entry of ") + key);
+    out.push_back(read(m));
+    m.done();
   }
 }
 
@@ -126,46 +129,36 @@ void check_references(const YamlReader& y, const YAML::Node& root, WorldDescript
 }
 
 WorldDescription parse(const YamlReader& y) {
-  const YAML::Node& root = y.root();
-  y.expect_map(root, "a world description");
-  y.allow_keys(root, {"name", "origin", "road_defaults", "geometry", "roads", "crosswalks", "stop_lines", "buildings",
-                      "poles", "trees", "parked_vehicles"});
+  YamlMap root(y, y.root(), "a world description");
   WorldDescription w;
   w.file = y.file();
-  w.name = y.string(y.required(root, "name"), "name");
+  w.name = y.string(root.required("name"), "name");
 
-  const YAML::Node origin = y.required(root, "origin");
-  y.expect_map(origin, "origin");
-  y.allow_keys(origin, {"lat", "lon", "alt"});
-  w.origin.lat_deg = y.number_in(y.required(origin, "lat"), "lat", -85.0, 85.0);
-  w.origin.lon_deg = y.number_in(y.required(origin, "lon"), "lon", -180.0, 180.0);
-  if (origin["alt"]) w.origin.alt_m = y.number_in(origin["alt"], "alt", -500.0, 9000.0);
+  YamlMap origin(y, root.required("origin"), "origin");
+  w.origin.lat_deg = y.number_in(origin.required("lat"), "lat", -85.0, 85.0);
+  w.origin.lon_deg = y.number_in(origin.required("lon"), "lon", -180.0, 180.0);
+  origin.number("alt", w.origin.alt_m, -500.0, 9000.0).done();
 
-  if (const YAML::Node g = root["geometry"]) {
-    y.expect_map(g, "geometry");
-    y.allow_keys(g, {"corner_radius", "curb_top_width", "paint_width", "paint_height", "dash_length", "dash_gap",
-                     "edge_line_inset", "stop_line_width", "crosswalk_stripe", "crosswalk_gap", "margin"});
-    auto& p = w.geometry;
-    y.read_number(g, "corner_radius", p.corner_radius, 0.0, 50.0);
-    y.read_number(g, "curb_top_width", p.curb_top_width, 0.05, 0.5);
-    y.read_number(g, "paint_width", p.paint_width, 0.05, 1.0);
-    y.read_number(g, "paint_height", p.paint_height, 0.001, 0.02);
-    y.read_number(g, "dash_length", p.dash_length, 0.5, 20.0);
-    y.read_number(g, "dash_gap", p.dash_gap, 0.5, 30.0);
-    y.read_number(g, "edge_line_inset", p.edge_line_inset, 0.1, 2.0);
-    y.read_number(g, "stop_line_width", p.stop_line_width, 0.1, 1.0);
-    y.read_number(g, "crosswalk_stripe", p.crosswalk_stripe, 0.2, 1.0);
-    y.read_number(g, "crosswalk_gap", p.crosswalk_gap, 0.2, 2.0);
-    y.read_number(g, "margin", p.margin, 0.0, 500.0);
-  }
+  auto& g = w.geometry;
+  YamlMap(y, root["geometry"], "geometry")
+      .number("corner_radius", g.corner_radius, 0.0, 50.0)
+      .number("curb_top_width", g.curb_top_width, 0.05, 0.5)
+      .number("paint_width", g.paint_width, 0.05, 1.0)
+      .number("paint_height", g.paint_height, 0.001, 0.02)
+      .number("dash_length", g.dash_length, 0.5, 20.0)
+      .number("dash_gap", g.dash_gap, 0.5, 30.0)
+      .number("edge_line_inset", g.edge_line_inset, 0.1, 2.0)
+      .number("stop_line_width", g.stop_line_width, 0.1, 1.0)
+      .number("crosswalk_stripe", g.crosswalk_stripe, 0.2, 1.0)
+      .number("crosswalk_gap", g.crosswalk_gap, 0.2, 2.0)
+      .number("margin", g.margin, 0.0, 500.0)
+      .done();
 
   RoadSpec defaults;
-  if (const YAML::Node d = root["road_defaults"]) {
-    y.expect_map(d, "road_defaults");
-    y.allow_keys(d, {ROAD_PROPERTY_KEYS});
-    read_road_properties(y, d, defaults);
-  }
-  const YAML::Node roads = y.required(root, "roads");
+  YamlMap road_defaults(y, root["road_defaults"], "road_defaults");
+  read_road_properties(road_defaults, defaults);
+  road_defaults.done();
+  const YAML::Node roads = root.required("roads");
   y.expect_sequence(roads, "roads");
   if (roads.size() == 0) y.fail(roads, "a world needs at least one road");
   for (const auto& n : roads) {
@@ -174,66 +167,58 @@ WorldDescription parse(const YamlReader& y) {
     w.roads.push_back(std::move(road));
   }
 
-  read_list(y, root, "crosswalks", w.crosswalks, [&](const YAML::Node& n) {
-    y.allow_keys(n, {"road", "at", "near", "width"});
+  read_list(root, "crosswalks", w.crosswalks, [&](YamlMap& m) {
     CrosswalkSpec c;
-    c.where = yaml_location(y.file(), n);
-    c.road = y.string(y.required(n, "road"), "road");
-    c.at = read_station(y, n, w, c.road);
-    if (n["width"]) c.width = y.number_in(n["width"], "width", 1.0, 20.0);
+    c.where = m.where();
+    c.road = y.string(m.required("road"), "road");
+    c.at = read_station(m, w, c.road);
+    m.number("width", c.width, 1.0, 20.0);
     return c;
   });
-  read_list(y, root, "stop_lines", w.stop_lines, [&](const YAML::Node& n) {
-    y.allow_keys(n, {"road", "at", "near", "side"});
+  read_list(root, "stop_lines", w.stop_lines, [&](YamlMap& m) {
     StopLineSpec s;
-    s.where = yaml_location(y.file(), n);
-    s.road = y.string(y.required(n, "road"), "road");
-    s.at = read_station(y, n, w, s.road);
-    if (n["side"]) s.side = read_side(y, n["side"]);
+    s.where = m.where();
+    s.road = y.string(m.required("road"), "road");
+    s.at = read_station(m, w, s.road);
+    if (const YAML::Node side = m["side"]) s.side = read_side(y, side);
     return s;
   });
-  read_list(y, root, "buildings", w.buildings, [&](const YAML::Node& n) {
-    y.allow_keys(n, {"centre", "size", "yaw_deg", "height", "material"});
+  read_list(root, "buildings", w.buildings, [&](YamlMap& m) {
     BuildingSpec b;
-    b.where = yaml_location(y.file(), n);
-    b.centre = y.vec2(y.required(n, "centre"), "centre");
-    b.size = y.vec2(y.required(n, "size"), "size");
-    if (b.size.minCoeff() < 1.0) y.fail(n["size"], "building size must be at least 1 m each way");
-    if (n["yaw_deg"]) b.yaw = y.number_in(n["yaw_deg"], "yaw_deg", -360.0, 360.0) * kDeg;
-    if (n["height"]) b.height = y.number_in(n["height"], "height", 2.0, 300.0);
-    if (n["material"]) b.material = y.string(n["material"], "material");
+    b.where = m.where();
+    b.centre = y.vec2(m.required("centre"), "centre");
+    const YAML::Node size = m.required("size");
+    b.size = y.vec2(size, "size");
+    if (b.size.minCoeff() < 1.0) y.fail(size, "building size must be at least 1 m each way");
+    m.degrees("yaw_deg", b.yaw, -360.0, 360.0).number("height", b.height, 2.0, 300.0).string("material", b.material);
     return b;
   });
-  read_list(y, root, "poles", w.poles, [&](const YAML::Node& n) {
-    y.allow_keys(n, {"road", "side", "spacing", "setback", "start", "height", "sign"});
+  read_list(root, "poles", w.poles, [&](YamlMap& m) {
     PoleRow p;
-    read_row(y, n, p);
-    if (n["height"]) p.height = y.number_in(n["height"], "height", 1.0, 20.0);
-    if (n["sign"]) p.sign = y.boolean(n["sign"], "sign");
+    read_row(m, p);
+    m.number("height", p.height, 1.0, 20.0).boolean("sign", p.sign);
     return p;
   });
-  read_list(y, root, "trees", w.trees, [&](const YAML::Node& n) {
-    y.allow_keys(n, {"road", "side", "spacing", "setback", "start", "height", "crown_radius"});
+  read_list(root, "trees", w.trees, [&](YamlMap& m) {
     TreeRow t;
-    read_row(y, n, t);
-    if (n["height"]) t.height = y.number_in(n["height"], "height", 2.0, 40.0);
-    if (n["crown_radius"]) t.crown_radius = y.number_in(n["crown_radius"], "crown_radius", 0.5, 10.0);
+    read_row(m, t);
+    m.number("height", t.height, 2.0, 40.0).number("crown_radius", t.crown_radius, 0.5, 10.0);
     return t;
   });
-  read_list(y, root, "parked_vehicles", w.parked, [&](const YAML::Node& n) {
-    y.allow_keys(n, {"type", "position", "yaw_deg"});
+  read_list(root, "parked_vehicles", w.parked, [&](YamlMap& m) {
     ParkedVehicleSpec p;
-    p.where = yaml_location(y.file(), n);
-    if (n["type"]) {
-      p.type = y.string(n["type"], "type");
+    p.where = m.where();
+    if (const YAML::Node type = m["type"]) {
+      p.type = y.string(type, "type");
       if (!actor_type_from_name(p.type))
-        y.fail(n["type"], "unknown vehicle type '" + p.type + "' (expected one of: " + actor_type_names() + ")");
+        y.fail(type, "unknown vehicle type '" + p.type + "' (expected one of: " + actor_type_names() + ")");
     }
-    p.position = y.vec2(y.required(n, "position"), "position");
-    if (n["yaw_deg"]) p.yaw = y.number_in(n["yaw_deg"], "yaw_deg", -360.0, 360.0) * kDeg;
+    p.position = y.vec2(m.required("position"), "position");
+    m.degrees("yaw_deg", p.yaw, -360.0, 360.0);
     return p;
   });
-  check_references(y, root, w);
+  root.done();
+  check_references(y, y.root(), w);
   return w;
 }
 
