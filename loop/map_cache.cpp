@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/input_error.hpp"
+#include "loop/survey_plot.hpp"
 #include "sim/world_assets.hpp"
 
 namespace lidarloop {
@@ -18,7 +19,9 @@ namespace lidarloop {
 namespace fs = std::filesystem;
 
 constexpr uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3ULL;
-constexpr int kMapFormatVersion = 1;  // bump when the mapping drive changes what it produces
+// Bump when the mapping drive changes what it produces. 2: the map is a survey (pose error, its own
+// HDL-32E unit, curbs moved by the survey error).
+constexpr int kMapFormatVersion = 2;
 
 static void hash_bytes(uint64_t& h, const std::string& bytes) {
   for (unsigned char c : bytes) h = (h ^ c) * kFnvPrime;
@@ -78,8 +81,10 @@ MapLocation ensure_map(const std::string& world_name, const MappingOptions& opti
   const std::string tmp = loc.dir + ".partial";
   fs::remove_all(tmp);
   builder.save(tmp);
-  write_curb_map(tmp + "/curbs.geojson", w.world.curb_map());
+  const SurveyDrive survey = mapping_survey(w.description, options);
+  write_curb_map(tmp + "/curbs.geojson", surveyed_curbs(w.world, survey, options));
   write_intensity_pngs(tmp, tmp + "/mean.png", tmp + "/variance.png");
+  write_survey_error_png(tmp + "/survey_error.png", w.world, survey);
   fs::remove_all(loc.dir);
   fs::rename(tmp, loc.dir);
   loc.built = true;

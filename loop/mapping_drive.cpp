@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "common/units.hpp"
 #include "sim/actor_assets.hpp"
 #include "sim/lidar_scanner.hpp"
 #include "sim/path.hpp"
@@ -16,33 +17,38 @@ constexpr double kTrafficSpacing = 45.0;  // m between oncoming vehicles
 constexpr double kTrafficSpeed = 9.0;     // m/s
 constexpr ActorType kTrafficTypes[] = {ActorType::car, ActorType::car, ActorType::truck, ActorType::bus};
 
-struct LaneDrive {
-  const RoadSpec* road;
-  bool backward;
-  Path path;
-};
-
-// Every lane to drive: right and left lanes of each travel direction that has them.
-std::vector<LaneDrive> lanes(const WorldDescription& d) {
-  std::vector<LaneDrive> out;
-  for (const auto& road : d.roads) {
-    const int per_direction = road.one_way ? road.lanes : std::max(1, road.lanes / 2);
-    for (bool backward : {false, true}) {
-      if (backward && road.one_way) continue;
-      out.push_back({&road, backward, lane_path(road, Lane::right, backward)});
-      if (per_direction >= 2) out.push_back({&road, backward, lane_path(road, Lane::left, backward)});
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 std::string MappingOptions::describe() const {
   std::ostringstream s;
   s << "traffic=" << traffic << " speed=" << speed << " resolution=" << resolution << " tile_cells=" << tile_cells
-    << " max_ground_height=" << max_ground_height << " max_range=" << max_range << " seed=" << seed;
+    << " max_ground_height=" << max_ground_height << " max_range=" << max_range << " seed=" << seed
+    << " survey_unit_serial=" << survey_unit_serial << " " << survey_error.describe();
   return s.str();
+}
+
+void read_survey_options(const YamlReader& yaml, const YAML::Node& node, MappingOptions& o) {
+  // Ranges that catch typos (a sigma in cm, a heading in rad), not physical limits.
+  constexpr double kMaxSigma = 10.0, kMaxHeadingSigmaDeg = 10.0, kMinLength = 0.01, kMaxLength = 1e7,
+                   kMaxSpacing = 10.0;
+  SurveyErrorConfig& e = o.survey_error;
+  YamlMap(yaml, node, "survey")
+      .integer("unit_serial", o.survey_unit_serial, 0, uint64_t(1) << 40)
+      .number("sigma_xy_m", e.sigma_xy_m, 0.0, kMaxSigma)
+      .number("correlation_length_m", e.correlation_length_m, kMinLength, kMaxLength)
+      .degrees("heading_sigma_deg", e.heading_sigma_rad, 0.0, kMaxHeadingSigmaDeg)
+      .number("heading_correlation_length_m", e.heading_correlation_length_m, kMinLength, kMaxLength)
+      .number("sample_spacing_m", e.sample_spacing_m, kMinLength, kMaxSpacing)
+      .done();
+}
+
+SurveyDrive mapping_survey(const WorldDescription& description, const MappingOptions& o) {
+  std::mt19937_64 rng(o.seed);
+  return plan_survey(description, o.survey_error, rng);
+}
+
+CurbMap surveyed_curbs(const World& world, const SurveyDrive& survey, const MappingOptions& o) {
+  return survey_curb_map(densify_curb_map(world.curb_map(), o.survey_error.sample_spacing_m), survey);
 }
 
 IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const World& world,
@@ -58,20 +64,20 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
   header.tile_cells = o.tile_cells;
   IntensityMapBuilder builder(header);
 
-  const Hdl32eConfig lidar;
+  Hdl32eConfig lidar;
+  lidar.unit_serial = o.survey_unit_serial;
   const LidarScanner scanner(lidar, materials);
   const Eigen::Isometry3d mount = lidar.mount();
   const int64_t period = lidar.scan_period_ns();
-  const auto drives = lanes(description);
-  double total = 0, done = 0;
-  for (const auto& d : drives) total += d.path.length;
+  const SurveyDrive survey = mapping_survey(description, o);
 
-  for (const auto& [road, backward, path] : drives) {
+  for (const SurveyLane& lane : survey.lanes) {
+    const Path& path = lane.path;
     // A fresh scene per lane, with oncoming traffic on the other side of this road if asked.
     RayScene scene(world.mesh);
     std::vector<ActorPlan> traffic;
-    if (o.traffic && !road->one_way) {
-      const Path other = lane_path(*road, Lane::right, !backward);
+    if (o.traffic && !lane.road->one_way) {
+      const Path other = lane_path(*lane.road, Lane::right, !lane.backward);
       for (double s = kTrafficSpacing / 2; s < other.length; s += kTrafficSpacing) {
         ActorPlan a;
         a.type = kTrafficTypes[traffic.size() % std::size(kTrafficTypes)];
@@ -83,12 +89,17 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
       add_actors(scene, traffic, actors_dir, materials);
     }
     const ActorPoses actor_poses = actor_motion(traffic);
-    const PoseAt vehicle = [&](int64_t t) { return to_isometry(path.pose_at(o.speed * double(t) * 1e-9)); };
+    // The car is where the truth says; its scans are placed where the survey says.
+    const PoseAt vehicle = [&](int64_t t) { return to_isometry(path.pose_at(o.speed * ns_to_s(t))); };
+    const PoseAt surveyed = [&](int64_t t) {
+      const double s = o.speed * ns_to_s(t);
+      return to_isometry(surveyed_pose(path.pose_at(s), survey.error.at(lane.start_m + s)));
+    };
     const int64_t scans = int64_t(path.length / o.speed / (double(period) * 1e-9));
     for (int64_t k = 0; k < scans; ++k) {
       const int64_t stamp = k * period;
       const PointCloud cloud = scanner.scan(scene, vehicle, stamp, o.seed, actor_poses);
-      // Ground truth places each point with the pose at its own firing cycle.
+      // The survey places each point with its pose at the point's own firing cycle.
       uint32_t cycle = UINT32_MAX;
       Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
       // The survey car is level: a point higher than this in the sensor frame cannot be ground.
@@ -97,16 +108,15 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
         if (p.z > max_sensor_z || double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z > o.max_range * o.max_range)
           continue;
         const uint32_t c = uint32_t(p.t_ns / lidar.cycle_period_ns());
-        if (c != cycle) cycle = c, sensor = vehicle(stamp + int64_t(c) * lidar.cycle_period_ns()) * mount;
+        if (c != cycle) cycle = c, sensor = surveyed(stamp + int64_t(c) * lidar.cycle_period_ns()) * mount;
         if (p.intensity > 100) continue;  // a sign or a reflector, not the road surface
         const Eigen::Vector3d local(p.x, p.y, p.z);
         const Eigen::Vector3d w = sensor * local;
         if (w.z() > o.max_ground_height) continue;
         builder.add(w.head<2>(), p.intensity);
       }
-      if (progress) progress((done + o.speed * double(stamp) * 1e-9) / total);
+      if (progress) progress((lane.start_m + o.speed * ns_to_s(stamp)) / survey.length_m);
     }
-    done += path.length;
   }
   return builder;
 }

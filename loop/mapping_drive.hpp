@@ -1,11 +1,16 @@
 #pragma once
-// The mapping drive: a simulated car with ground-truth poses drives every lane of every road (both
-// directions on two-way roads) and accumulates the intensities of ground returns into the intensity
-// layer, as a survey vehicle does before a localizer can run.
+// The mapping drive: a simulated survey car drives every lane of every road (both directions on
+// two-way roads) and accumulates the intensities of ground returns into the intensity layer, as a
+// survey vehicle does before a localizer can run. The map is a survey, not the world: each scan is
+// placed with the pose the survey car's RTK-INS reports (the truth plus loop/survey_error.hpp's error),
+// and the survey car's HDL-32E is another unit than the test car's, with its own per-laser gains.
 #include <functional>
+#include <random>
 #include <string>
 
+#include "common/yaml_reader.hpp"
 #include "localizer/intensity_map.hpp"
+#include "loop/survey_map.hpp"
 #include "sim/materials.hpp"
 #include "sim/world_builder.hpp"
 
@@ -20,10 +25,26 @@ struct MappingOptions {
   // by, which is how traffic raises the variance of the cells it crosses (paper, section 2.2.2).
   double max_ground_height = 0.5;
   double max_range = 40.0;  // m: farther ground returns are too sparse to help
-  uint64_t seed = 1;
+  uint64_t seed = 1;        // the LiDAR's noise and the survey error
+  SurveyErrorConfig survey_error;
+  // The survey car's HDL-32E (Hdl32eConfig::unit_serial): another unit than the test car's, whose
+  // default serial is 1, so the map's per-laser intensity gains are not the scans'.
+  uint64_t survey_unit_serial = 2;
 
-  std::string describe() const;  // the options as text, for the cache key and the map header
+  std::string describe() const;  // every option as text, for the cache key and the map header
 };
+
+// Overrides of the survey settings from a YAML mapping: unit_serial, sigma_xy_m, correlation_length_m,
+// heading_sigma_deg, heading_correlation_length_m, sample_spacing_m.
+void read_survey_options(const YamlReader& yaml, const YAML::Node& node, MappingOptions& options);
+
+// The survey the mapping drive with these options makes: its lanes and its error, drawn from an engine
+// seeded with options.seed (the same every time for the same options).
+SurveyDrive mapping_survey(const WorldDescription& description, const MappingOptions& options);
+
+// The surveyed curb layer: the world's curbs densified to the survey's sample spacing and moved by the
+// survey error (survey_curb_map).
+CurbMap surveyed_curbs(const World& world, const SurveyDrive& survey, const MappingOptions& options);
 
 // `world_hash` identifies what the map is built from (see map_cache.hpp); it goes into the header.
 IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const World& world,

@@ -1,12 +1,17 @@
 // lidarloop map: build (or find) a world's HD map; the `bench map` memory benchmark lives here too.
 #include <sys/resource.h>
 #include <chrono>
+#include <cmath>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
 
+#include "common/units.hpp"
+#include "common/yaml_reader.hpp"
 #include "localizer/hd_map.hpp"
 #include "loop/map_cache.hpp"
 #include "sim/path.hpp"
@@ -25,12 +30,49 @@ MappingOptions mapping_options(const Args& args) {
   if (o.resolution < 0.05 || o.resolution > 2.0) throw InputError("--resolution must be 0.05 to 2 m");
   o.speed = args.number("speed", o.speed);
   if (o.speed < 1 || o.speed > 40) throw InputError("--speed must be 1 to 40 m/s");
+  if (const auto file = args.value("survey")) {
+    const YamlReader yaml = YamlReader::open(*file);
+    read_survey_options(yaml, yaml.root(), o);
+  }
   return o;
+}
+
+// The survey's error and what it does to the curbs, recomputed from the options (cheap: no LiDAR), so
+// the figures are printed whether the map was built now or found in the cache.
+void print_survey(const std::string& world, const MappingOptions& o, const std::string& map_dir) {
+  constexpr double kCm = 100.0;
+  const LoadedWorld w = load_world(world);
+  const SurveyDrive survey = mapping_survey(w.description, o);
+  double east2 = 0, north2 = 0, heading2 = 0, max_position = 0, max_heading = 0;
+  for (const Pose2d& e : survey.error.samples) {
+    east2 += e.x * e.x, north2 += e.y * e.y, heading2 += e.yaw * e.yaw;
+    max_position = std::max(max_position, std::hypot(e.x, e.y));
+    max_heading = std::max(max_heading, std::abs(e.yaw));
+  }
+  const double n = double(std::max<size_t>(1, survey.error.samples.size()));
+  const CurbMap world_curbs = densify_curb_map(w.world.curb_map(), o.survey_error.sample_spacing_m);
+  const CurbShiftStats c = curb_shift_stats(world_curbs, survey_curb_map(world_curbs, survey));
+  auto fixed = [](double v, int digits) {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(digits) << v;
+    return s.str();
+  };
+  std::cout << "survey       " << fixed(survey.length_m / 1000, 2) << " km of lanes, HDL-32E unit "
+            << o.survey_unit_serial << "; position error RMS east " << fixed(std::sqrt(east2 / n) * kCm, 2)
+            << " cm, north " << fixed(std::sqrt(north2 / n) * kCm, 2) << " cm, max " << fixed(max_position * kCm, 2)
+            << " cm; heading RMS " << fixed(std::sqrt(heading2 / n) * kDegPerRad, 3) << " deg, max "
+            << fixed(max_heading * kDegPerRad, 3) << " deg\n"
+            << "curb shift   across the curb line: mean " << fixed(c.across_mean_m * kCm, 2) << " cm, sigma "
+            << fixed(c.across_sigma_m * kCm, 2) << " cm, max " << fixed(c.across_max_abs_m * kCm, 2)
+            << " cm; whole shift mean " << fixed(c.shift_mean_m * kCm, 2) << " cm, max "
+            << fixed(c.shift_max_m * kCm, 2) << " cm (" << c.points << " curb points)\n"
+            << "survey plot  " << map_dir << "/survey_error.png\n";
 }
 
 int run_map(const Args& args) {
   const auto limit = limit_threads(thread_count(args));
-  const MapLocation loc = ensure_map(args.positional().at(0), mapping_options(args), args.flag("force"));
+  const MappingOptions options = mapping_options(args);
+  const MapLocation loc = ensure_map(args.positional().at(0), options, args.flag("force"));
   const IntensityMapHeader h = read_intensity_map_header(loc.dir);
   std::cout << "map          " << loc.dir << (loc.built ? " (built)" : " (found in the cache)") << "\n";
   if (loc.built) std::cout << "built in     " << loc.build_s << " s\n";
@@ -38,6 +80,7 @@ int run_map(const Args& args) {
             << "intensity    " << h.tiles.size() << " tiles of " << h.tile_size_m() << " m, " << h.resolution_m
             << " m cells; mean.png, variance.png\n"
             << "curbs        " << loc.dir << "/curbs.geojson\n";
+  print_survey(args.positional().at(0), options, loc.dir);
   return 0;
 }
 
@@ -94,13 +137,16 @@ int bench_map(const Args& args) {
 
 Command map_command() {
   return {{"map",
-           "lidarloop map WORLD [--traffic] [--force] [--resolution M] [--speed V]",
+           "lidarloop map WORLD [--traffic] [--force] [--resolution M] [--speed V] [--survey FILE.yaml]",
            "Build a world's HD map by a mapping drive over every lane (or find it in the cache): the curb\n"
-           "layer (GeoJSON) and the intensity layer (tiles of per-cell count, mean and variance, Eq. 8).",
+           "layer (GeoJSON) and the intensity layer (tiles of per-cell count, mean and variance, Eq. 8).\n"
+           "The map is a survey: scans placed with an RTK-INS pose error, by another HDL-32E unit, and the\n"
+           "curbs moved by that error; prints the error and writes survey_error.png beside the map.",
            {{"traffic", "", "oncoming traffic during the drive (raises the variance of the cells it crosses)"},
             {"force", "", "rebuild even if the cache has this map"},
             {"resolution", "M", "intensity cell size (default 0.2 m)"},
-            {"speed", "M_S", "mapping drive speed (default 12 m/s)"},
+            {"speed", "M_S", "mapping drive speed (default 15 m/s)"},
+            {"survey", "FILE", "survey settings in YAML (unit_serial, sigma_xy_m, heading_sigma_deg, ...)"},
             {"threads", "N", "worker threads (default: all cores)"}},
            1,
            1},
