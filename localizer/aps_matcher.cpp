@@ -321,6 +321,8 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
   result.offset_vehicle = moments.mean;
   result.position = origin + R * moments.mean;  // Eq. 17-18, the offset rotated from the vehicle frame
   result.covariance = R * moments.covariance * R.transpose();
+  const Eigen::Vector2d uniform = uniform_over_window(window).diagonal();
+  for (int k = 0; k < 2; ++k) result.spread_ratio[k] = uniform[k] > 0 ? moments.covariance(k, k) / uniform[k] : 1.0;
   return result;
 }
 

@@ -72,6 +72,9 @@ struct ApsResult {
   // Covariance of P over the offsets (plus the step's quantisation), local frame (m^2): the
   // observation noise for the Kalman filter. When !ok: that of a uniform spread over the window.
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();
+  // (longitudinal, lateral): the variance of P on each axis over that of a uniform spread over the
+  // window's extent on it; near 1 the match says nothing on that axis. 1 for an axis not searched.
+  Eigen::Vector2d spread_ratio = Eigen::Vector2d::Ones();
   int cells_used = 0;  // cells of S that entered Eq. 14
   // The most probable offset lies on the window's border: the true one may well be outside, and the
   // centroid is then pulled towards the middle of a window that does not contain it.

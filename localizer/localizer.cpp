@@ -142,7 +142,8 @@ std::string describe_health(uint32_t flags) {
                                                                   "few curbs",
                                                                   "curb match rejected",
                                                                   "no intensity match",
-                                                                  "intensity match rejected"};
+                                                                  "intensity match rejected",
+                                                                  "intensity match ambiguous"};
   if (flags == 0) return "ok";
   std::string out;
   for (int i = 0; i < kHealthFlagCount; ++i)
@@ -455,10 +456,21 @@ void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
     e.health |= kIntensityMatchRejected;
     return;
   }
-  if (params_.aps_longitudinal_only_with_curbs && e.curb_observation && !(e.health & kCurbMatchRejected))
-    filter_->update_intensity_along(aps.position, R, Eigen::Vector2d(std::cos(prior.yaw), std::sin(prior.yaw)));
-  else
+  // Beyond the paper: an axis along which Eq. 14's distribution is about as wide as the search window
+  // carries no information (a solid line along the road and nothing marking the position along it);
+  // its centre of mass only follows the map's noise and the window's edges, and a drift it starts is
+  // never taken back. Such an axis is left to the other sensors.
+  const bool curbs_hold_lateral =
+      params_.aps_longitudinal_only_with_curbs && e.curb_observation && !(e.health & kCurbMatchRejected);
+  const bool along = aps.spread_ratio.x() <= params_.aps_max_spread_ratio;
+  const bool across = aps.spread_ratio.y() <= params_.aps_max_spread_ratio && !curbs_hold_lateral;
+  const Eigen::Vector2d forward(std::cos(prior.yaw), std::sin(prior.yaw)), left(-forward.y(), forward.x());
+  if (along && across)
     filter_->update_intensity(aps.position, R);  // KF2
+  else if (along || across)
+    filter_->update_intensity_along(aps.position, R, along ? forward : left);
+  else
+    e.health |= kIntensityAmbiguous;
 }
 
 void Localizer::report_pose(LocalizerEstimate& e) const {

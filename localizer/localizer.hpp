@@ -42,8 +42,9 @@ enum HealthFlag : uint32_t {
   kCurbMatchRejected = 1u << 8,  // the curb match disagreed with the filter or explained too few curbs
   kNoIntensityMatch = 1u << 9,   // APS had too few usable cells (off the intensity map, road hidden)
   kIntensityMatchRejected = 1u << 10,
+  kIntensityAmbiguous = 1u << 11,  // APS's distribution was as wide as its window on every axis it may update
 };
-constexpr int kHealthFlagCount = 11;
+constexpr int kHealthFlagCount = 12;
 // "ok", or the set flags as words: "no GPS, few curbs".
 std::string describe_health(uint32_t flags);
 

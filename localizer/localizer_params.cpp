@@ -32,6 +32,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   top.number("icp_window_sigmas", p.icp_window_sigmas, 0.0, 100.0);
   top.number("aps_covariance_scale", p.aps_covariance_scale, 1e-3, 1e3);
   top.boolean("aps_longitudinal_only_with_curbs", p.aps_longitudinal_only_with_curbs);
+  top.number("aps_max_spread_ratio", p.aps_max_spread_ratio, 0.0, 10.0);
   top.number("icp_max_correspondence_m", p.icp_max_correspondence_m, 0.1, 100.0);
   top.number("aps_max_lateral_range_m", p.aps_max_lateral_range_m, 0.0, 50.0);
   top.number("aps_max_longitudinal_range_m", p.aps_max_longitudinal_range_m, 0.0, 50.0);

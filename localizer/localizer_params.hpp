@@ -89,6 +89,9 @@ struct LocalizerParams {
   // that APS sees across a road is periodic: zebra stripes and parallel lane lines let a wrong
   // lateral peak look sharp (seen as 3-6 cm lateral spikes at the crosswalks of dynamic_campus).
   bool aps_longitudinal_only_with_curbs = true;
+  // Beyond the paper: APS updates an axis only where its distribution's variance is at most this
+  // fraction of a uniform spread over the search window's extent on that axis (1 = no information).
+  double aps_max_spread_ratio = 0.5;
   VehicleModelParams vehicle;
   PoseFilterParams filter;
   double process_position_without_can_per_s = 2.0;  // m per s of dead reckoning without CAN

@@ -19,6 +19,7 @@
 
 #include "localizer/aps_matcher.hpp"
 #include "localizer/intensity_map.hpp"
+#include "localizer/localizer_params.hpp"
 
 namespace lidarloop {
 namespace {
@@ -244,6 +245,12 @@ TEST_F(Aps, AFeaturelessRoadGivesABroadDistribution) {
               std::sqrt(c_flat(1, 1)), std::sqrt(c_marked(0, 0)), std::sqrt(c_marked(1, 1)));
   EXPECT_GT(std::sqrt(c_flat(0, 0)), 0.5);
   EXPECT_GT(c_flat.trace(), 10 * c_marked.trace());
+  // Against a uniform spread over the window: plain asphalt says nothing on either axis, the crosswalk
+  // pins both (the localizer updates only the axes at most aps_max_spread_ratio wide).
+  std::printf("[ aps ] spread ratio (long, lat): flat (%.2f, %.2f), crosswalk (%.3f, %.3f)\n", r_flat.spread_ratio.x(),
+              r_flat.spread_ratio.y(), r_marked.spread_ratio.x(), r_marked.spread_ratio.y());
+  EXPECT_GT(r_flat.spread_ratio.minCoeff(), LocalizerParams{}.aps_max_spread_ratio);
+  EXPECT_LT(r_marked.spread_ratio.maxCoeff(), 0.05);
 }
 
 TEST_F(Aps, TooFewUsableCellsGiveNoEstimate) {
