@@ -10,11 +10,14 @@ case "$what" in run|test) ;; *) echo "usage: tools/quickstart.sh run|test" >&2; 
 
 tools/install_deps.sh
 jobs=$(nproc)
-build() {  # build DIR [cmake options...]: every option is given each time, so nothing an earlier
-           # configuration of DIR left in its cache (say, the tests switched off by `run`) carries over
+configure() {  # configure DIR [cmake options...]: every option is given each time, so nothing an earlier
+               # configuration of DIR left in its cache (say, the tests switched off by `run`) carries over
   local dir=$1; shift
   cmake -S . -B "$dir" -G Ninja "$@" >/dev/null
-  cmake --build "$dir" -j "$jobs"
+}
+build() {  # build DIR [cmake options...]: configure, then build everything
+  configure "$@"
+  cmake --build "$1" -j "$jobs"
 }
 # Fails when a label has no tests: a configuration that silently left a group out must not pass.
 expect_tests() {  # expect_tests DIR LABEL...
@@ -40,8 +43,9 @@ fi
 build build -DCMAKE_BUILD_TYPE=Release -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=OFF
 expect_tests build unit cli scenario map node
 ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs"
-# The unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer.
-build build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=ON
+# The unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer: only what they run is built.
+configure build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=ON
+cmake --build build-sanitize -j "$jobs" --target unit_tests
 expect_tests build-sanitize unit
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j "$jobs" -L unit
