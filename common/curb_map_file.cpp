@@ -20,8 +20,10 @@ void write_curb_map(const std::string& path, const CurbMap& map) {
       const Geodetic g = frame.to_geodetic(p);
       coordinates.push_back({g.lon_deg, g.lat_deg});
     }
+    json properties = {{"kind", "curb"}, {"id", i}};
+    if (i < map.kinds.size()) properties["curb"] = map.kinds[i];
     features.push_back({{"type", "Feature"},
-                        {"properties", {{"kind", "curb"}, {"id", i}}},
+                        {"properties", properties},
                         {"geometry", {{"type", "LineString"}, {"coordinates", coordinates}}}});
   }
   // The origin travels with the map as a foreign member, so a reader recovers the same local frame.
@@ -82,7 +84,11 @@ CurbMap read_curb_map(const std::string& path) {
     }
     if (line.size() < 2) throw InputError(path + ": " + where + " has fewer than 2 points");
     map.curbs.push_back(std::move(line));
+    const json properties = f.value("properties", json::object());
+    if (properties.is_object() && properties.contains("curb") && properties["curb"].is_string())
+      map.kinds.resize(map.curbs.size()), map.kinds.back() = properties["curb"].get<std::string>();
   }
+  if (!map.kinds.empty()) map.kinds.resize(map.curbs.size());
   return map;
 }
 

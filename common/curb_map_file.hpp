@@ -16,6 +16,9 @@ struct CurbMap {
   Geodetic origin;                // the local frame's origin
   std::string world;              // name of the world it was made from (may be empty)
   std::vector<Polyline2d> curbs;  // local metres
+  // What each curb line is (kinds[i] for curbs[i]): vertical, sloped, rolled, or a cut (driveway,
+  // ramp, flush); empty when the map does not say.
+  std::vector<std::string> kinds;
 };
 
 void write_curb_map(const std::string& path, const CurbMap& map);

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "localizer/points_kd_tree.hpp"
+#include "common/points_kd_tree.hpp"
 
 namespace lidarloop {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "localizer/points_kd_tree.hpp"
+#include "common/points_kd_tree.hpp"
 
 namespace lidarloop {
 

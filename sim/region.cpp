@@ -38,7 +38,7 @@ struct Mesher {
   const std::function<float(const Eigen::Vector2d&)>& height;
   MaterialId material;
   TriangleMesh& mesh;
-  cInt leaf_size, min_size;
+  cInt leaf_size, min_size, max_square;
 
   void emit(const Path& polygon) {
     const auto base = static_cast<uint32_t>(mesh.vertices.size());
@@ -60,7 +60,9 @@ struct Mesher {
       has_hole = has_hole || !ClipperLib::Orientation(p);
     }
     if (covered >= double(size) * double(size) * (1 - 1e-9)) {
-      emit(square(x0, y0, size)[0]);
+      const cInt step = std::min(size, max_square);
+      for (cInt y = y0; y < y0 + size; y += step)
+        for (cInt x = x0; x < x0 + size; x += step) emit(square(x, y, step)[0]);
       return;
     }
     if (size > leaf_size || (has_hole && size > min_size)) {
@@ -153,7 +155,7 @@ double area(const Paths& region) {
 }
 
 void mesh_region(const Paths& region, double tile_size, const std::function<float(const Eigen::Vector2d&)>& height,
-                 MaterialId material, TriangleMesh& mesh) {
+                 MaterialId material, TriangleMesh& mesh, double max_square) {
   if (region.empty()) return;
   const auto leaf = static_cast<cInt>(std::llround(tile_size * kScale));
   cInt min_x = INT64_MAX, min_y = INT64_MAX, max_x = INT64_MIN, max_y = INT64_MIN;
@@ -167,7 +169,12 @@ void mesh_region(const Paths& region, double tile_size, const std::function<floa
   const cInt x0 = floor_to(min_x, leaf), y0 = floor_to(min_y, leaf);
   cInt size = leaf;
   while (x0 + size < max_x || y0 + size < max_y) size *= 2;
-  Mesher mesher{height, material, mesh, leaf, std::max<cInt>(leaf / 16, 1)};
+  // Full squares are split into leaves of the same power-of-two grid, so they still meet their neighbours.
+  const double max_full = std::min(max_square * kScale, 4e18);
+  cInt full = leaf;
+  while (double(full) * 2 <= max_full && full < size) full *= 2;
+  while (double(full) > max_full && full > 1) full /= 2;
+  Mesher mesher{height, material, mesh, leaf, std::max<cInt>(leaf / 16, 1), full};
   mesher.node(region, x0, y0, size);
 }
 

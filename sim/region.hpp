@@ -35,10 +35,11 @@ double area(const Paths& region);
 
 // Triangulates a region as a surface whose height is given per vertex, by a quadtree on a global grid
 // (so neighbouring regions share tile edges): squares wholly inside the region become two triangles
-// whatever their size; squares the region's edge crosses are split down to `tile_size`, and further
-// while a piece has a hole, so every piece ear-clipped is a small simple polygon.
+// each at most `max_square` wide (so a curved surface is sampled that densely); squares the region's
+// edge crosses are split down to `tile_size`, and further while a piece has a hole, so every piece
+// ear-clipped is a small simple polygon.
 void mesh_region(const Paths& region, double tile_size, const std::function<float(const Eigen::Vector2d&)>& height,
-                 MaterialId material, TriangleMesh& mesh);
+                 MaterialId material, TriangleMesh& mesh, double max_square = 1e9);
 
 // Ear-clipping triangulation of a simple polygon; returns index triples into `polygon`.
 std::vector<std::array<uint32_t, 3>> triangulate_polygon(const ClipperLib::Path& polygon);

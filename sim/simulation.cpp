@@ -24,9 +24,11 @@ Simulation::Simulation(const Scenario& scenario, const WorldDescription& descrip
       can_(scenario.can, mix64(scenario.seed ^ kCanStream)),
       gps_(scenario.gps, LocalFrame(description.origin), mix64(scenario.seed ^ kGpsStream)),
       rtk_(scenario.rtk, LocalFrame(description.origin), mix64(scenario.seed ^ kRtkStream)),
-      control_period_ns_(kControlPeriodNs) {
-  add_actors(*scene_, resolved_.actors, actors_dir, materials);
-  actor_poses_ = actor_motion(resolved_.actors);
+      control_period_ns_(kControlPeriodNs),
+      ground_(world.ground()),
+      pavement_(world.pavement()) {
+  add_actors(*scene_, resolved_.actors, actors_dir, materials, ground_);
+  actor_poses_ = actor_motion(resolved_.actors, ground_);
   trajectory_.push_back(vehicle_.rear_axle_pose());
 }
 
@@ -81,7 +83,9 @@ void Simulation::emit_scan(StreamSink& sink) {
     const size_t i = std::min(poses.size() - 2, size_t(std::max(0.0, std::floor(u))));
     const double f = std::clamp(u - double(i), 0.0, 1.0);
     const Pose2d &a = poses[i], &b = poses[i + 1];
-    return to_isometry({a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), a.yaw + f * wrap_angle(b.yaw - a.yaw)});
+    const VehicleParams& v = scenario_.ego.vehicle;
+    return rest_on_ground({a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), a.yaw + f * wrap_angle(b.yaw - a.yaw)},
+                          pavement_, v.wheelbase(), v.track_width);
   };
   const PointCloud cloud =
       scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses_);

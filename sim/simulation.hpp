@@ -67,6 +67,8 @@ class Simulation {
   ControllerCommand command_;
   int64_t now_ = 0;
   int64_t control_period_ns_;
+  GroundHeight ground_;    // where actors stand
+  GroundHeight pavement_;  // where the ego's wheels roll
   int64_t scan_index_ = 0;
   std::vector<Pose2d> trajectory_;  // rear-axle pose at every step of the scan being recorded
   int64_t trajectory_start_ns_ = 0;

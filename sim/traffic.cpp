@@ -24,25 +24,29 @@ double actor_distance(const ActorPlan& plan, int64_t t_ns) {
 
 Pose2d actor_pose2d(const ActorPlan& plan, int64_t t_ns) { return plan.path.pose_at(actor_distance(plan, t_ns)); }
 
-Eigen::Isometry3d actor_pose(const ActorPlan& plan, int64_t t_ns) { return to_isometry(actor_pose2d(plan, t_ns)); }
+Eigen::Isometry3d actor_pose(const ActorPlan& plan, int64_t t_ns, const GroundHeight& ground) {
+  Eigen::Isometry3d pose = to_isometry(actor_pose2d(plan, t_ns));
+  if (ground) pose.translation().z() = ground(pose.translation().head<2>());
+  return pose;
+}
 
 void add_actors(RayScene& scene, const std::vector<ActorPlan>& actors, const std::string& actors_dir,
-                const MaterialTable& materials) {
+                const MaterialTable& materials, const GroundHeight& ground) {
   std::map<ActorType, int> prototypes;  // one BVH per actor type, instanced for every actor of it
   for (const auto& a : actors) {
     if (!prototypes.count(a.type))
       prototypes[a.type] = scene.add_prototype(load_actor_mesh(actors_dir, a.type, materials));
-    scene.add_actor(prototypes[a.type], actor_pose(a, 0));
+    scene.add_actor(prototypes[a.type], actor_pose(a, 0, ground));
   }
   scene.commit();
 }
 
-ActorPoses actor_motion(std::vector<ActorPlan> actors) {
+ActorPoses actor_motion(std::vector<ActorPlan> actors, GroundHeight ground) {
   bool moving = false;
   for (const auto& a : actors) moving = moving || a.speed > 0;
   if (!moving) return {};
-  return [actors = std::move(actors)](int64_t t_ns, std::vector<Eigen::Isometry3d>& poses) {
-    for (size_t i = 0; i < actors.size(); ++i) poses[i] = actor_pose(actors[i], t_ns);
+  return [actors = std::move(actors), ground = std::move(ground)](int64_t t_ns, std::vector<Eigen::Isometry3d>& poses) {
+    for (size_t i = 0; i < actors.size(); ++i) poses[i] = actor_pose(actors[i], t_ns, ground);
   };
 }
 

@@ -11,6 +11,7 @@
 #include "sim/actor_assets.hpp"
 #include "sim/lidar_scanner.hpp"
 #include "sim/path.hpp"
+#include "sim/road_surface.hpp"
 
 namespace lidarloop {
 
@@ -32,14 +33,15 @@ struct ActorPlan {
 // Arc length travelled along the path by time t (waits included, clamped at the end of an open path).
 double actor_distance(const ActorPlan& plan, int64_t t_ns);
 Pose2d actor_pose2d(const ActorPlan& plan, int64_t t_ns);
-Eigen::Isometry3d actor_pose(const ActorPlan& plan, int64_t t_ns);  // footprint centre on the ground
+// Footprint centre on the ground (at z = 0 without one).
+Eigen::Isometry3d actor_pose(const ActorPlan& plan, int64_t t_ns, const GroundHeight& ground = {});
 
 // Puts the actors into the scene (one BVH per actor type, an instance per actor, at their t = 0 poses)
 // and commits it.
 void add_actors(RayScene& scene, const std::vector<ActorPlan>& actors, const std::string& actors_dir,
-                const MaterialTable& materials);
+                const MaterialTable& materials, const GroundHeight& ground = {});
 // Where those actors are at any time, in the order added: what the scanner asks while casting.
 // Empty when none of them moves.
-ActorPoses actor_motion(std::vector<ActorPlan> actors);
+ActorPoses actor_motion(std::vector<ActorPlan> actors, GroundHeight ground = {});
 
 }  // namespace lidarloop

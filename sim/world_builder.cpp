@@ -4,75 +4,49 @@
 #include <map>
 #include <memory>
 
-#include <nanoflann.hpp>
-
 #include "common/input_error.hpp"
 #include "sim/actor_assets.hpp"
+#include "sim/curb_band.hpp"
 #include "sim/polyline.hpp"
 
 namespace lidarloop {
 namespace {
 
-constexpr double kGroundTile = 8.0;       // m; ground triangles are at most this size near edges
+constexpr double kGroundTile = 8.0;       // m; verge triangles are at most this size near edges
+constexpr double kVergeSquare = 4.0;      // m; verge squares sample the terrain's hills this densely
+constexpr double kRoadTile = 0.5;         // m; pavement and sidewalks: crown, roughness, ramps
+constexpr double kCurbStation = 0.5;      // m between cross-sections of the curb band
+constexpr double kPaintPiece = 0.5;       // m; paint is draped over the pavement in pieces this long
 constexpr double kIntersectionPad = 2.0;  // m beyond the corner radius where lane paint stops
 constexpr double kCrosswalkPad = 1.0;     // m before a crosswalk where lane paint stops
 
-// Height of the raised ground (curb tops, sidewalks, verges): the curb height of the nearest road.
-// Copies share the samples and their KD-tree, so it can live in a std::function.
-class RaisedLevel {
- public:
-  explicit RaisedLevel(const std::vector<RoadSpec>& roads) : constant_(float(roads.front().curb_height)) {
-    bool uniform = true;
-    for (const auto& r : roads) uniform = uniform && r.curb_height == roads.front().curb_height;
-    if (uniform) return;
-    samples_ = std::make_shared<Samples>();
-    for (const auto& r : roads) {
-      const double len = polyline_length(r.centreline);
-      for (double s = 0; s <= len; s += 1.0) {
-        samples_->points.push_back(sample_polyline(r.centreline, s).point);
-        samples_->heights.push_back(float(r.curb_height));
-      }
-    }
-    index_ = std::make_shared<Index>(2, *samples_, nanoflann::KDTreeSingleIndexAdaptorParams(10));
-    index_->buildIndex();
-  }
-  float operator()(const Eigen::Vector2d& p) const {
-    if (!index_) return constant_;
-    uint32_t nearest = 0;
-    double dist2 = 0;
-    index_->knnSearch(p.data(), 1, &nearest, &dist2);
-    return samples_->heights[nearest];
-  }
-
- private:
-  struct Samples {  // nanoflann dataset interface
-    std::vector<Eigen::Vector2d> points;
-    std::vector<float> heights;
-    size_t kdtree_get_point_count() const { return points.size(); }
-    double kdtree_get_pt(size_t i, size_t dim) const { return points[i][int(dim)]; }
-    template <class BBox>
-    bool kdtree_get_bbox(BBox&) const {
-      return false;
-    }
-  };
-  using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Samples>, Samples, 2>;
-  float constant_;
-  std::shared_ptr<Samples> samples_;
-  std::shared_ptr<Index> index_;
-};
-
 Eigen::Vector2d left_normal(const Eigen::Vector2d& tangent) { return {-tangent.y(), tangent.x()}; }
 
-// A quad strip of paint along a polyline.
-void add_paint_line(TriangleMesh& mesh, const Polyline2d& line, double half_width, float z, MaterialId m) {
+// A quad of paint draped over the pavement `height` above it: split along its length into pieces,
+// each corner at the pavement's height there.
+void add_paint_quad(TriangleMesh& mesh, const Eigen::Vector2d& centre, const Eigen::Vector2d& along, double half_length,
+                    double half_width, const RoadSurface& surface, double height, MaterialId m) {
+  const Eigen::Vector2d u = along.normalized(), v(-u.y(), u.x());
+  const int pieces = std::max(1, int(std::ceil(2 * half_length / kPaintPiece)));
+  const auto base = static_cast<uint32_t>(mesh.vertices.size());
+  for (int k = 0; k <= pieces; ++k)
+    for (double side : {-1.0, 1.0}) {
+      const Eigen::Vector2d p = centre + u * (half_length * (2.0 * k / pieces - 1)) + v * (side * half_width);
+      mesh.vertices.emplace_back(float(p.x()), float(p.y()), float(surface.carriageway(p) + height));
+    }
+  for (uint32_t k = 0; k < uint32_t(pieces); ++k) {  // vertices 2k (right), 2k + 1 (left)
+    mesh.add_triangle(base + 2 * k, base + 2 * k + 2, base + 2 * k + 3, m);
+    mesh.add_triangle(base + 2 * k, base + 2 * k + 3, base + 2 * k + 1, m);
+  }
+}
+
+// A strip of paint along a polyline.
+void add_paint_line(TriangleMesh& mesh, const Polyline2d& line, double half_width, const RoadSurface& surface,
+                    double height, MaterialId m) {
   for (size_t i = 1; i < line.size(); ++i) {
     const Eigen::Vector2d d = line[i] - line[i - 1];
     if (d.norm() < 1e-4) continue;
-    const Eigen::Vector2f c = (0.5 * (line[i] + line[i - 1])).cast<float>();
-    const Eigen::Vector2f u = (d / d.norm()).cast<float>();
-    const Eigen::Vector2f v(-u.y(), u.x());
-    const float hl = float(0.5 * d.norm()), hw = float(half_width);
-    add_flat_quad(mesh, {c - u * hl - v * hw, c + u * hl - v * hw, c + u * hl + v * hw, c - u * hl + v * hw}, z, m);
+    add_paint_quad(mesh, 0.5 * (line[i] + line[i - 1]), d, 0.5 * d.norm(), half_width, surface, height, m);
   }
 }
 
@@ -115,8 +89,7 @@ struct Builder {
                                      region::strip(road.centreline, road.width / 2 + road.sidewalk_width, road.closed));
     }
     world.carriageway = region::closing(road_union, r);
-    world.sidewalks = region::unite(region::closing(sidewalk_union, r),
-                                    region::offset(world.carriageway, desc.geometry.curb_top_width));
+    world.sidewalks = region::closing(sidewalk_union, r);
     // Where two roads overlap is an intersection: no lane paint there or around its rounded corners.
     for (size_t i = 0; i < strips.size(); ++i)
       for (size_t j = i + 1; j < strips.size(); ++j) {
@@ -124,7 +97,6 @@ struct Builder {
         if (!overlap.empty())
           no_lane_paint = region::unite(no_lane_paint, region::offset(overlap, r + kIntersectionPad));
       }
-    for (const auto& c : world.carriageway) world.curbs.push_back(region::to_polyline(c, true));
   }
 
   void check_off_carriageway(const std::vector<Eigen::Vector2d>& footprint, const std::string& where,
@@ -137,6 +109,25 @@ struct Builder {
 
   void build_ground() {
     const auto& g = desc.geometry;
+    // The curb band along the carriageway's edge (Clipper keeps the filled side on the left of every
+    // ring, outer or hole), and the raised ground that continues from its top.
+    std::vector<Polyline2d> edges;
+    for (const auto& c : world.carriageway) edges.push_back(region::to_polyline(c, true));
+    const CurbBandWidths band = curb_band_widths(desc);
+    auto raised = std::make_shared<const RaisedGround>(curb_stations(edges, desc, *world.surface, kCurbStation),
+                                                       world.surface, g, band.outer);
+    world.curb_band = raised;
+    world.raised_level = [raised](const Eigen::Vector2d& p) { return float((*raised)(p)); };
+    curb_lines(raised->rings(), world.curbs, world.curb_kinds);
+    region::Paths inner, outer;
+    for (const auto& ring : raised->rings()) {
+      inner.push_back(region::to_path(offset_ring(ring, -band.inner)));
+      outer.push_back(region::to_path(offset_ring(ring, band.outer)));
+    }
+    inner = region::unite(inner, {});
+    outer = region::unite(outer, {});
+    world.sidewalks = region::unite(world.sidewalks, outer);
+
     Eigen::AlignedBox2d box;
     for (const auto& path : world.sidewalks)
       for (const auto& p : region::to_polyline(path, false)) box.extend(p);
@@ -146,37 +137,22 @@ struct Builder {
     box.max() += Eigen::Vector2d::Constant(g.margin);
     world.bounds = box;
 
-    const region::Paths curb_tops =
-        region::subtract(region::offset(world.carriageway, g.curb_top_width), world.carriageway);
-    const region::Paths sidewalk = region::subtract(
-        world.sidewalks, region::unite(world.carriageway, region::offset(world.carriageway, g.curb_top_width)));
+    const region::Paths sidewalk = region::subtract(world.sidewalks, outer);
     const region::Paths verge = region::subtract(
         region::rectangle(box.center(), {1, 0}, box.sizes().x() / 2, box.sizes().y() / 2), world.sidewalks);
-    auto flat = [](const Eigen::Vector2d&) { return 0.0f; };
-    region::mesh_region(world.carriageway, kGroundTile, flat, mat("asphalt"), world.mesh);
-    region::mesh_region(curb_tops, kGroundTile, world.raised_level, mat("curb_concrete"), world.mesh);
-    region::mesh_region(sidewalk, kGroundTile, world.raised_level, mat("sidewalk"), world.mesh);
-    region::mesh_region(verge, kGroundTile, world.raised_level, mat("grass"), world.mesh);
-
-    // Curb faces: vertical quads from the asphalt up to the raised level, facing the carriageway
-    // (Clipper keeps the filled side on the left of every ring, outer or hole).
-    const MaterialId curb = mat("curb_concrete");
-    for (const auto& ring : world.curbs)
-      for (size_t i = 1; i < ring.size(); ++i) {
-        const Eigen::Vector2f a = ring[i - 1].cast<float>(), b = ring[i].cast<float>();
-        const auto base = static_cast<uint32_t>(world.mesh.vertices.size());
-        world.mesh.vertices.insert(world.mesh.vertices.end(), {{a.x(), a.y(), 0.0f},
-                                                               {b.x(), b.y(), 0.0f},
-                                                               {b.x(), b.y(), world.raised_level(ring[i])},
-                                                               {a.x(), a.y(), world.raised_level(ring[i - 1])}});
-        world.mesh.add_triangle(base + 1, base, base + 3, curb);
-        world.mesh.add_triangle(base + 1, base + 3, base + 2, curb);
-      }
+    const RoadSurface& surface = *world.surface;
+    auto pavement = [&surface](const Eigen::Vector2d& p) { return float(surface.carriageway(p)); };
+    region::mesh_region(band.inner > 0 ? region::intersect(world.carriageway, inner) : world.carriageway, kRoadTile,
+                        pavement, mat("asphalt"), world.mesh, kRoadTile);
+    mesh_curb_band(*raised, surface, band, mat("asphalt"), mat("curb_concrete"), world.mesh);
+    region::mesh_region(sidewalk, kRoadTile, world.raised_level, mat("sidewalk"), world.mesh, kRoadTile);
+    region::mesh_region(verge, kGroundTile, world.raised_level, mat("grass"), world.mesh, kVergeSquare);
   }
 
   void build_markings() {
     const auto& g = desc.geometry;
-    const float z = static_cast<float>(g.paint_height);
+    const RoadSurface& surface = *world.surface;
+    const double z = g.paint_height;
     const MaterialId lane = mat("lane_paint"), zebra = mat("crosswalk_paint");
     for (const auto& c : desc.crosswalks) {
       const RoadSpec& road = *desc.road(c.road);
@@ -189,20 +165,17 @@ struct Builder {
       for (int k = 0; k < stripes; ++k) {
         const double lateral = (k - (stripes - 1) / 2.0) * period;
         const Eigen::Vector2d centre = s.point + n * lateral;
-        const Polyline2d rect =
-            region::to_polyline(region::rectangle(centre, s.tangent, c.width / 2, g.crosswalk_stripe / 2)[0], false);
-        add_flat_quad(world.mesh,
-                      {rect[0].cast<float>(), rect[1].cast<float>(), rect[2].cast<float>(), rect[3].cast<float>()}, z,
-                      zebra);
+        add_paint_quad(world.mesh, centre, s.tangent, c.width / 2, g.crosswalk_stripe / 2, surface, z, zebra);
       }
     }
     for (const auto& sl : desc.stop_lines) {
       const RoadSpec& road = *desc.road(sl.road);
       const PolylineSample s = sample_polyline(road.centreline, sl.at);
       const Eigen::Vector2d n = left_normal(s.tangent);
-      const double lo = sl.side == RoadSide::left ? 0.0 : -road.width / 2 + g.edge_line_inset;
-      const double hi = sl.side == RoadSide::right ? 0.0 : road.width / 2 - g.edge_line_inset;
-      add_paint_line(world.mesh, {s.point + n * lo, s.point + n * hi}, g.stop_line_width / 2, z, lane);
+      const double inset = g.edge_line_inset + road.gutter_width;
+      const double lo = sl.side == RoadSide::left ? 0.0 : -road.width / 2 + inset;
+      const double hi = sl.side == RoadSide::right ? 0.0 : road.width / 2 - inset;
+      add_paint_line(world.mesh, {s.point + n * lo, s.point + n * hi}, g.stop_line_width / 2, surface, z, lane);
     }
     for (const auto& road : desc.roads) {
       std::vector<Polyline2d> solid, dashed;
@@ -213,12 +186,13 @@ struct Builder {
               offset_polyline(road.centreline, -road.width / 2 + k * road.width / road.lanes, road.closed));
       if (road.edge_lines)
         for (double side : {-1.0, 1.0})
-          solid.push_back(offset_polyline(road.centreline, side * (road.width / 2 - g.edge_line_inset), road.closed));
+          solid.push_back(offset_polyline(
+              road.centreline, side * (road.width / 2 - g.edge_line_inset - road.gutter_width), road.closed));
       for (const auto& line : region::clip_lines_outside(solid, no_lane_paint))
-        add_paint_line(world.mesh, line, g.paint_width / 2, z, lane);
+        add_paint_line(world.mesh, line, g.paint_width / 2, surface, z, lane);
       for (const auto& line : region::clip_lines_outside(dashed, no_lane_paint))
         for (const auto& dash : dashes(line, g.dash_length, g.dash_gap))
-          add_paint_line(world.mesh, dash, g.paint_width / 2, z, lane);
+          add_paint_line(world.mesh, dash, g.paint_width / 2, surface, z, lane);
     }
   }
 
@@ -293,11 +267,22 @@ struct Builder {
 
 }  // namespace
 
+GroundHeight World::ground() const {
+  auto area = std::make_shared<const region::Paths>(carriageway);
+  return [area, surface = surface, raised = raised_level](const Eigen::Vector2d& p) {
+    return region::contains(*area, p) ? surface->carriageway(p) : double(raised(p));
+  };
+}
+
+GroundHeight World::pavement() const {
+  return [surface = surface](const Eigen::Vector2d& p) { return surface->carriageway(p); };
+}
+
 World build_world(const WorldDescription& description, const MaterialTable& materials, const std::string& actors_dir) {
   Builder b{description, materials, actors_dir, {}, {}};
   b.world.name = description.name;
   b.world.origin = description.origin;
-  b.world.raised_level = RaisedLevel(description.roads);
+  b.world.surface = std::make_shared<const RoadSurface>(description);
   b.build_regions();
   b.build_ground();
   b.build_markings();

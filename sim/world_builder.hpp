@@ -2,16 +2,19 @@
 // The world generator: turns a WorldDescription into a triangle mesh with a material per triangle,
 // and the curb lines that become the curb map.
 //
-// Surfaces: the carriageway (asphalt) lies at z = 0. Curb faces rise vertically from it along the
-// carriageway's boundary to the curb height; curb tops, sidewalks and the ground beyond are at that
-// raised level. Where roads with different curb heights meet, the raised level takes the height of
-// the nearest road. Paint lies `paint_height` above the asphalt.
+// Surfaces: the carriageway follows the terrain, falls from each road's centreline to its curbs (the
+// crown) and is rough as its ISO 8608 class. Along its edge runs the curb band (sim/curb_band.hpp:
+// gutter, face, top, cuts); curb tops, ramps, sidewalks and the ground beyond continue from it. Paint
+// lies `paint_height` above the pavement.
+#include <memory>
 #include <string>
 
 #include <Eigen/Geometry>
 
+#include "sim/curb_band.hpp"
 #include "sim/materials.hpp"
 #include "sim/region.hpp"
+#include "sim/road_surface.hpp"
 #include "sim/world_description.hpp"
 
 namespace lidarloop {
@@ -20,13 +23,23 @@ struct World {
   std::string name;
   Geodetic origin;
   TriangleMesh mesh;
-  std::vector<Polyline2d> curbs;  // closed rings along the carriageway's edge (first point repeated)
-  region::Paths carriageway;      // area between the curbs
-  region::Paths sidewalks;        // carriageway + curbs + sidewalks
+  // Lines along the carriageway's edge, split where the curb's kind changes (closed rings repeat their
+  // first point), and each one's kind: a profile (vertical, sloped, rolled) or a cut (driveway, ramp,
+  // flush).
+  std::vector<Polyline2d> curbs;
+  std::vector<std::string> curb_kinds;
+  region::Paths carriageway;  // area between the curbs
+  region::Paths sidewalks;    // carriageway + curbs + sidewalks
   Eigen::AlignedBox2d bounds;
-  std::function<float(const Eigen::Vector2d&)> raised_level;  // sidewalk height at a point
+  std::shared_ptr<const RoadSurface> surface;                 // terrain, crown, roughness
+  std::shared_ptr<const RaisedGround> curb_band;              // the curbs' cross-sections
+  std::function<float(const Eigen::Vector2d&)> raised_level;  // curb top / sidewalk height at a point
 
-  CurbMap curb_map() const { return {origin, name, curbs}; }
+  CurbMap curb_map() const { return {origin, name, curbs, curb_kinds}; }
+  // What stands on the world: the pavement on the carriageway, the raised ground elsewhere. The
+  // function keeps what it needs, so it outlives the World.
+  GroundHeight ground() const;
+  GroundHeight pavement() const;  // the carriageway's surface, extended everywhere
 };
 
 // actors_dir holds the OBJ meshes of parked vehicles (assets/actors). Throws InputError naming the

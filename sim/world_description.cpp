@@ -30,6 +30,22 @@ RoadSide read_side(const YamlReader& y, const YAML::Node& n) {
   y.fail(n, "side must be left, right or both, got '" + s + "'");
 }
 
+CurbProfile read_curb_profile(const YamlReader& y, const YAML::Node& n) {
+  const std::string s = y.string(n, "curb_profile");
+  if (s == "vertical") return CurbProfile::vertical;
+  if (s == "sloped") return CurbProfile::sloped;
+  if (s == "rolled") return CurbProfile::rolled;
+  y.fail(n, "curb_profile must be vertical, sloped or rolled, got '" + s + "'");
+}
+
+CurbCut read_cut_kind(const YamlReader& y, const YAML::Node& n) {
+  const std::string s = y.string(n, "kind");
+  if (s == "driveway") return CurbCut::driveway;
+  if (s == "ramp") return CurbCut::ramp;
+  if (s == "flush") return CurbCut::flush;
+  y.fail(n, "kind must be driveway, ramp or flush, got '" + s + "'");
+}
+
 // Road properties that may appear both in road_defaults and on each road.
 void read_road_properties(YamlMap& m, RoadSpec& road) {
   const YamlReader& y = m.reader();
@@ -39,8 +55,20 @@ void read_road_properties(YamlMap& m, RoadSpec& road) {
       .boolean("edge_lines", road.edge_lines)
       .number("curb_height", road.curb_height, 0.05, 0.30)
       .number("sidewalk_width", road.sidewalk_width, 0.0, 15.0)
-      .number("smoothing_radius", road.smoothing_radius, 0.0, 500.0);
+      .number("smoothing_radius", road.smoothing_radius, 0.0, 500.0)
+      .number("cross_slope", road.cross_slope, 0.0, 0.08)
+      .number("curb_height_variation", road.curb_height_variation, 0.0, 0.1)
+      .number("gutter_width", road.gutter_width, 0.0, 1.8)
+      .number("gutter_slope", road.gutter_slope, 0.0, 0.12)
+      .number("driveway_spacing", road.driveway_spacing, 0.0, 1000.0)
+      .number("driveway_width", road.driveway_width, 2.0, 15.0);
   if (const YAML::Node marking = m["marking"]) road.marking = read_marking(y, marking);
+  if (const YAML::Node profile = m["curb_profile"]) road.curb_profile = read_curb_profile(y, profile);
+  if (road.curb_height_variation >= road.curb_height)
+    y.fail(m["curb_height_variation"] ? m["curb_height_variation"] : m.node(),
+           "curb_height_variation must be below curb_height");
+  if (road.driveway_spacing > 0 && road.driveway_spacing <= road.driveway_width)
+    y.fail(m["driveway_spacing"], "driveway_spacing must exceed driveway_width");
 }
 
 RoadSpec read_road(const YamlReader& y, const YAML::Node& n, const RoadSpec& defaults) {
@@ -124,6 +152,7 @@ void check_references(const YamlReader& y, const YAML::Node& root, WorldDescript
     check("crosswalks", i, w.crosswalks[i].road, w.crosswalks[i].at, true);
   for (size_t i = 0; i < w.stop_lines.size(); ++i)
     check("stop_lines", i, w.stop_lines[i].road, w.stop_lines[i].at, true);
+  for (size_t i = 0; i < w.curb_cuts.size(); ++i) check("curb_cuts", i, w.curb_cuts[i].road, w.curb_cuts[i].at, true);
   for (size_t i = 0; i < w.poles.size(); ++i) check("poles", i, w.poles[i].road, 0, false);
   for (size_t i = 0; i < w.trees.size(); ++i) check("trees", i, w.trees[i].road, 0, false);
 }
@@ -140,8 +169,8 @@ WorldDescription parse(const YamlReader& y) {
   origin.number("alt", w.origin.alt_m, -500.0, 9000.0).done();
 
   auto& g = w.geometry;
-  YamlMap(y, root["geometry"], "geometry")
-      .number("corner_radius", g.corner_radius, 0.0, 50.0)
+  YamlMap geometry(y, root["geometry"], "geometry");
+  geometry.number("corner_radius", g.corner_radius, 0.0, 50.0)
       .number("curb_top_width", g.curb_top_width, 0.05, 0.5)
       .number("paint_width", g.paint_width, 0.05, 1.0)
       .number("paint_height", g.paint_height, 0.001, 0.02)
@@ -152,7 +181,21 @@ WorldDescription parse(const YamlReader& y) {
       .number("crosswalk_stripe", g.crosswalk_stripe, 0.2, 1.0)
       .number("crosswalk_gap", g.crosswalk_gap, 0.2, 2.0)
       .number("margin", g.margin, 0.0, 500.0)
-      .done();
+      .number("sidewalk_cross_slope", g.sidewalk_cross_slope, 0.0, 0.1)
+      .number("ramp_slope", g.ramp_slope, 0.01, 0.5)
+      .number("flare_slope", g.flare_slope, 0.01, 0.5)
+      .number("roughness_min_wavelength", g.roughness_min_wavelength, 0.1, 100.0)
+      .number("roughness_max_wavelength", g.roughness_max_wavelength, 0.1, 1000.0)
+      .integer("roughness_seed", g.roughness_seed, 0, uint64_t(1) << 62);
+  if (const YAML::Node c = geometry["roughness_class"]) {
+    const std::string s = y.string(c, "roughness_class");
+    if (s != "none" && (s.size() != 1 || s[0] < 'A' || s[0] > 'E'))
+      y.fail(c, "roughness_class must be an ISO 8608 class A-E or none, got '" + s + "'");
+    g.roughness_class = s == "none" ? '-' : s[0];
+  }
+  if (g.roughness_min_wavelength >= g.roughness_max_wavelength)
+    y.fail(geometry.node(), "roughness_min_wavelength must be below roughness_max_wavelength");
+  geometry.done();
 
   RoadSpec defaults;
   YamlMap road_defaults(y, root["road_defaults"], "road_defaults");
@@ -182,6 +225,24 @@ WorldDescription parse(const YamlReader& y) {
     s.at = read_station(m, w, s.road);
     if (const YAML::Node side = m["side"]) s.side = read_side(y, side);
     return s;
+  });
+  read_list(root, "curb_cuts", w.curb_cuts, [&](YamlMap& m) {
+    CurbCutSpec c;
+    c.where = m.where();
+    c.road = y.string(m.required("road"), "road");
+    c.at = read_station(m, w, c.road);
+    if (const YAML::Node side = m["side"]) c.side = read_side(y, side);
+    if (c.side == RoadSide::both) y.fail(m["side"], "a curb cut is on one side: left or right");
+    m.number("length", c.length, 1.0, 500.0);
+    if (const YAML::Node kind = m["kind"]) c.kind = read_cut_kind(y, kind);
+    return c;
+  });
+  read_list(root, "hills", w.hills, [&](YamlMap& m) {
+    Hill h;
+    h.centre = y.vec2(m.required("centre"), "centre");
+    h.radius = y.number_in(m.required("radius"), "radius", 10.0, 1e5);
+    h.height = y.number_in(m.required("height"), "height", -200.0, 200.0);
+    return h;
   });
   read_list(root, "buildings", w.buildings, [&](YamlMap& m) {
     BuildingSpec b;

@@ -13,6 +13,13 @@ namespace lidarloop {
 
 enum class MarkingStyle { none, solid, dashed };
 enum class RoadSide { left, right, both };  // relative to the centreline's direction
+// The curb's cross-section (AASHTO "A Policy on Geometric Design of Highways and Streets", section 4.7:
+// vertical or barrier curbs, and sloping curbs that vehicles can mount; rolled curbs are the S-shaped
+// mountable kind of residential streets).
+enum class CurbProfile { vertical, sloped, rolled };
+// Where a curb is cut to the level of the road: a driveway, a curb ramp (ADA Standards 406), or a
+// stretch with no curb at all (a bus bay or lay-by, a parking lane with a painted edge only).
+enum class CurbCut { driveway, ramp, flush };
 
 struct RoadSpec {
   std::string name;
@@ -28,6 +35,19 @@ struct RoadSpec {
   double curb_height = 0.15;
   double sidewalk_width = 3.0;
   double smoothing_radius = 0;  // fillet radius for centreline corners
+  // The carriageway falls by this much per metre from its centreline to each curb (the crown):
+  // TxDOT Roadway Design Manual, 2 % recommended, 1-4 % allowed.
+  double cross_slope = 0.02;
+  CurbProfile curb_profile = CurbProfile::vertical;
+  // Curb reveal varies along a road, mostly because asphalt overlays bury part of it (a 40-50 mm mill
+  // and overlay lowers it by that much): the height wanders smoothly within +-this, m.
+  double curb_height_variation = 0;
+  // Gutter pan in front of the curb (AASHTO Green Book 4.7: 0.3-1.8 m wide at 5-8 % towards the curb);
+  // 0 = none, the pavement meets the curb face.
+  double gutter_width = 0;
+  double gutter_slope = 0.06;
+  double driveway_spacing = 0;  // m between driveway cuts along each side; 0 = none
+  double driveway_width = 4.0;  // m, at the curb line
 };
 
 struct CrosswalkSpec {
@@ -40,6 +60,23 @@ struct StopLineSpec {
   std::string where, road;
   double at = 0;
   RoadSide side = RoadSide::right;  // which half of the carriageway it spans
+};
+
+// A curb cut written in the world file (driveways at regular spacing come from the road's keys;
+// ramps at crosswalks are made for every crosswalk).
+struct CurbCutSpec {
+  std::string where, road;
+  RoadSide side = RoadSide::right;
+  double at = 0;       // arc length of its centre along the road's centreline, m
+  double length = 10;  // along the curb, m
+  CurbCut kind = CurbCut::flush;
+};
+
+// A hill of the terrain: a raised-cosine bump, so roads across it climb and descend with a grade
+// of at most pi/2 * height / radius.
+struct Hill {
+  Eigen::Vector2d centre{0, 0};
+  double radius = 100, height = 0;
 };
 
 struct BuildingSpec {
@@ -76,10 +113,22 @@ struct WorldGeometryParams {
   double paint_width = 0.15;
   double paint_height = 0.003;  // paint stands this far above the asphalt
   double dash_length = 3.0, dash_gap = 6.0;
-  double edge_line_inset = 0.3;  // edge line centre from the curb
+  double edge_line_inset = 0.3;  // edge line centre from the curb, or from the gutter's lip
   double stop_line_width = 0.4;
   double crosswalk_stripe = 0.45, crosswalk_gap = 0.6;
   double margin = 30.0;  // ground beyond the outermost object
+  // Sidewalks rise away from the curb; ADA Standards 403.3 allow at most 1:48, built to 1.5 % so
+  // construction tolerance stays within it.
+  double sidewalk_cross_slope = 0.015;
+  // A curb ramp or driveway rises back to the sidewalk at most this steeply (ADA 406.1 / 405.2: 1:12),
+  // and curbs taper down to a cut over flared sides of at most 1:10 (ADA 406.3).
+  double ramp_slope = 1.0 / 12.0;
+  double flare_slope = 1.0 / 10.0;
+  // Pavement unevenness as an ISO 8608 road class (A very good ... E very poor), between these
+  // wavelengths; shorter ones are texture the beam footprint averages away, longer ones are grade.
+  char roughness_class = 'B';                                              // or '-' for a perfectly smooth pavement
+  double roughness_min_wavelength = 0.5, roughness_max_wavelength = 10.0;  // m
+  uint64_t roughness_seed = 1;
 };
 
 struct WorldDescription {
@@ -89,6 +138,8 @@ struct WorldDescription {
   std::vector<RoadSpec> roads;
   std::vector<CrosswalkSpec> crosswalks;
   std::vector<StopLineSpec> stop_lines;
+  std::vector<CurbCutSpec> curb_cuts;
+  std::vector<Hill> hills;
   std::vector<BuildingSpec> buildings;
   std::vector<PoleRow> poles;
   std::vector<TreeRow> trees;

@@ -35,7 +35,7 @@ double reflectivity(double x, double y) {
 }
 
 HdMap synthetic_map() {
-  CurbMap curbs{kOrigin, "synthetic", {{{-200, kCurbY}, {800, kCurbY}}, {{-200, -kCurbY}, {800, -kCurbY}}}};
+  CurbMap curbs{kOrigin, "synthetic", {{{-200, kCurbY}, {800, kCurbY}}, {{-200, -kCurbY}, {800, -kCurbY}}}, {}};
   IntensityMapHeader header;
   header.world = "synthetic";
   header.origin = kOrigin;

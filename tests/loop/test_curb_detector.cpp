@@ -14,6 +14,8 @@
 #include "sim/lidar_scanner.hpp"
 #include "sim/path.hpp"
 #include "sim/polyline.hpp"
+#include "sim/road_surface.hpp"
+#include "sim/vehicle_model.hpp"
 #include "sim/world_assets.hpp"
 #include "test_support.hpp"
 
@@ -32,10 +34,13 @@ std::unique_ptr<RayScene> campus_scene(const Traffic& traffic) {
   const LoadedWorld& w = campus();
   auto scene = std::make_unique<RayScene>(w.world.mesh);
   std::map<ActorType, int> prototypes;  // one mesh per type, however many actors share it
+  const GroundHeight ground = w.world.ground();
   for (const auto& [type, pose] : traffic) {
     if (!prototypes.count(type))
       prototypes[type] = scene->add_prototype(load_actor_mesh(test::data_path("assets/actors"), type, w.materials));
-    scene->add_actor(prototypes[type], pose);
+    Eigen::Isometry3d on_ground = pose;  // standing on the crowned road or the sidewalk
+    on_ground.translation().z() = ground(pose.translation().head<2>());
+    scene->add_actor(prototypes[type], on_ground);
   }
   scene->commit();
   return scene;
@@ -69,7 +74,9 @@ Detection detect_on_straight(double x, const Traffic& traffic = {}) {
   const std::unique_ptr<RayScene> scene_owner = campus_scene(traffic);
   RayScene& scene = *scene_owner;
   const Hdl32eConfig config;
-  const Eigen::Isometry3d vehicle(Eigen::Translation3d(x, -2.25, 0));
+  const VehicleParams car;
+  const GroundHeight pavement = w.world.pavement();
+  const Eigen::Isometry3d vehicle = rest_on_ground({x, -2.25, 0}, pavement, car.wheelbase(), car.track_width);
   const VehicleScan scan = scan_from(scene, vehicle, 9);
   const auto curbs = detect_curbs(scan.points, scan.rings, CurbDetectorParams{});
   Detection d;
@@ -88,7 +95,7 @@ Detection detect_on_straight(double x, const Traffic& traffic = {}) {
   const Eigen::Vector3d sensor = vehicle * config.mount().translation();
   auto visible = [&](const Eigen::Vector2d& p) {
     constexpr double kNearTarget = 0.5;  // m: hits this close to the curb are the curb or the road by it
-    const Eigen::Vector3d to = Eigen::Vector3d(p.x(), p.y(), 0.0) - sensor;
+    const Eigen::Vector3d to = Eigen::Vector3d(p.x(), p.y(), pavement(p)) - sensor;
     const Ray ray{sensor.cast<float>(), to.normalized().cast<float>()};
     RayHit hit;
     return !scene.intersect(ray, 0.0f, float(to.norm() - kNearTarget), hit);
@@ -203,7 +210,8 @@ TEST(CurbDetector, FindsExactlyTheOraclesCurbsOnCampusScansWithTraffic) {
   for (size_t k = 0; k < stops.size(); ++k) {
     const RoadSpec& road = *w.description.road(stops[k].road);
     const Path lane = lane_path(road, Lane::right, stops[k].backward);
-    vehicles.push_back(to_isometry(lane.pose_at(stops[k].s)));
+    const VehicleParams car;
+    vehicles.push_back(rest_on_ground(lane.pose_at(stops[k].s), w.world.pavement(), car.wheelbase(), car.track_width));
     add_traffic(road, lane, stops[k].s, k % 2 == 0, traffic);
   }
   const std::unique_ptr<RayScene> scene = campus_scene(traffic);

@@ -149,7 +149,7 @@ std::string saved_map(const std::string& folder, const std::string& name, const 
   IntensityMapBuilder b(h);
   for (double x = -5; x < 5; x += 0.1) b.add({x, 0.5}, 10 + x);
   b.save(dir);
-  write_curb_map(dir + "/curbs.geojson", CurbMap{curb_origin, name, {{{-5, 4}, {5, 4}}}});
+  write_curb_map(dir + "/curbs.geojson", CurbMap{curb_origin, name, {{{-5, 4}, {5, 4}}}, {}});
   return dir;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
-// A nanoflann KD-tree over a vector of 2-D points it does not own: the index behind the curb layer's
-// window queries and the curb matcher's unbounded nearest-neighbour queries. Include it only from
-// .cpp files, so nanoflann stays out of the localizer's headers.
+// A nanoflann KD-tree over a vector of 2-D points it does not own: the index behind the world's road
+// and curb lookups (sim), the curb layer's window queries and the curb matcher's nearest-neighbour
+// queries (localizer). Include it only from .cpp files, so nanoflann stays out of every header.
 #include <cstddef>
 #include <vector>
 
