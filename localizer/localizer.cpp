@@ -68,13 +68,14 @@ std::vector<size_t> corridor_points(const ScanPoints& points, const CurbLayer& c
 // the ground points close to the plane (see IntensityGridParams::max_height).
 std::vector<size_t> split_ground_and_obstacles(const ScanPoints& points, const std::vector<size_t>& corridor,
                                                const LocalizerParams& params, std::vector<Eigen::Vector2d>& obstacles,
-                                               LocalizerEstimate& e) {
+                                               std::optional<Plane>& plane, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::obstacles));
   std::vector<Eigen::Vector3d> corridor_xyz;
   corridor_xyz.reserve(corridor.size());
   for (size_t i : corridor) corridor_xyz.push_back(points.xyz[i]);
   const ObstacleSplit split = reject_obstacles(corridor_xyz, params.obstacles);
   if (!split.plane_ok) e.health |= kNoGroundPlane;
+  if (split.plane_ok) plane = split.plane;
   std::vector<size_t> ground;
   for (size_t k : split.ground_index)
     if (!split.plane_ok || distance_to_plane(split.plane, corridor_xyz[k]) <= params.intensity_grid.max_height)
@@ -84,11 +85,14 @@ std::vector<size_t> split_ground_and_obstacles(const ScanPoints& points, const s
   return ground;
 }
 
-// 2.2.1, single frame: the curbs along the scan's rings (vehicle frame).
-std::vector<Eigen::Vector2d> detect_scan_curbs(const ScanPoints& points, const CurbDetectorParams& params,
-                                               LocalizerEstimate& e) {
+// 2.2.1, single frame: the curbs along the scan's rings (vehicle frame). Beyond the paper: with a
+// ground plane (2.1.2) the detector reads heights above it, so a car rolled on a crowned road or
+// pitched on a grade sees its curbs as a level one would.
+std::vector<Eigen::Vector2d> detect_scan_curbs(const ScanPoints& points, const std::optional<Plane>& plane,
+                                               const CurbDetectorParams& params, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::curb_detection));
-  std::vector<Eigen::Vector2d> curbs = detect_curbs(points.xyz, points.ring, params);
+  std::vector<Eigen::Vector2d> curbs =
+      detect_curbs(plane ? level_to_plane(points.xyz, *plane) : points.xyz, points.ring, params);
   e.curbs_detected = curbs.size();
   return curbs;
 }
@@ -281,14 +285,15 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
   }
 
   std::vector<size_t> ground;  // the road surface, indices into points
+  std::optional<Plane> plane;
   if (removes_obstacles(method)) {
     const std::vector<size_t> corridor =
-        corridor_points(points, map_.curbs, filter_->pose(), params_.corridor, e);           // 2.1.1
-    ground = split_ground_and_obstacles(points, corridor, params_, features_.obstacles, e);  // 2.1.2
+        corridor_points(points, map_.curbs, filter_->pose(), params_.corridor, e);                  // 2.1.1
+    ground = split_ground_and_obstacles(points, corridor, params_, features_.obstacles, plane, e);  // 2.1.2
   }
   if (uses_curbs(method))  // 2.2.1
     features_.curbs =
-        curb_features(detect_scan_curbs(points, params_.curb_detector, e), features_.obstacles, motion, e);
+        curb_features(detect_scan_curbs(points, plane, params_.curb_detector, e), features_.obstacles, motion, e);
   std::optional<IntensityGrid> S;
   if (uses_intensity(method)) S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, e);  // 2.2.2
 

@@ -104,6 +104,12 @@ double height_above_plane(const Plane& plane, const Eigen::Vector3d& p) {
          std::sqrt(plane.a0 * plane.a0 + plane.a1 * plane.a1 + 1.0);
 }
 
+std::vector<Eigen::Vector3d> level_to_plane(const std::vector<Eigen::Vector3d>& points, const Plane& plane) {
+  std::vector<Eigen::Vector3d> out(points);
+  for (Eigen::Vector3d& p : out) p.z() = height_above_plane(plane, p);
+  return out;
+}
+
 double distance_to_plane(const Plane& plane, const Eigen::Vector3d& p) {
   return std::abs(height_above_plane(plane, p));  // Eq. 3
 }

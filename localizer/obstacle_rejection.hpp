@@ -41,6 +41,11 @@ double distance_to_plane(const Plane& plane, const Eigen::Vector3d& p);
 // Signed perpendicular distance: positive above the plane (z larger than the plane's z at (x, y)).
 double height_above_plane(const Plane& plane, const Eigen::Vector3d& p);
 
+// The points with z replaced by their height above the plane (x, y kept): the scan as a level sensor
+// over flat ground would see it. A car on a crowned road rolls by the crown's slope, about 1 deg at 2 %,
+// which lifts the road 9 cm at 5 m to one side and sinks it on the other.
+std::vector<Eigen::Vector3d> level_to_plane(const std::vector<Eigen::Vector3d>& points, const Plane& plane);
+
 struct ObstacleSplit {
   std::vector<Eigen::Vector3d> ground, obstacles;
   // Where each ground / obstacle point sits in the input, so callers can carry per-point data along.

@@ -230,14 +230,16 @@ double RaisedGround::operator()(const Eigen::Vector2d& p) const {
   return sum / weights;
 }
 
-void mesh_curb_band(const RaisedGround& raised, const RoadSurface& surface, CurbBandWidths widths,
-                    MaterialId pavement, MaterialId concrete, TriangleMesh& mesh) {
+void mesh_curb_band(const RaisedGround& raised, const RoadSurface& surface, CurbBandWidths widths, MaterialId pavement,
+                    MaterialId concrete, TriangleMesh& mesh) {
   constexpr int kPoints = 4 + kFaceSamples;  // inner edge, gutter lip, foot, face samples, outer edge
   for (const auto& ring : raised.rings()) {
     const auto base = static_cast<uint32_t>(mesh.vertices.size());
     for (const CurbStation& c : ring) {
       auto at = [&](double o) { return Eigen::Vector2d(c.point + c.normal * (c.miter * o)); };
-      auto add = [&](const Eigen::Vector2d& xy, double z) { mesh.vertices.emplace_back(float(xy.x()), float(xy.y()), float(z)); };
+      auto add = [&](const Eigen::Vector2d& xy, double z) {
+        mesh.vertices.emplace_back(float(xy.x()), float(xy.y()), float(z));
+      };
       add(at(-widths.inner), surface.carriageway(at(-widths.inner)));
       add(at(-c.gutter_width), c.gutter_width > 0 ? surface.carriageway(at(-c.gutter_width)) : c.bottom_z);
       add(c.point, c.bottom_z);

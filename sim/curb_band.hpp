@@ -27,19 +27,19 @@ const char* curb_cut_name(CurbCut cut);
 
 // One cross-section of the band, at a point of a curb line.
 struct CurbStation {
-  Eigen::Vector2d point;       // the curb line: the carriageway's edge, where the face starts
-  Eigen::Vector2d normal;      // unit, away from the carriageway
-  double miter = 1;            // offsets along `normal` are scaled by this to stay parallel to the line
-  int road = -1;               // the road whose curb this is
-  double s = 0;                // arc length along that road's centreline
+  Eigen::Vector2d point;   // the curb line: the carriageway's edge, where the face starts
+  Eigen::Vector2d normal;  // unit, away from the carriageway
+  double miter = 1;        // offsets along `normal` are scaled by this to stay parallel to the line
+  int road = -1;           // the road whose curb this is
+  double s = 0;            // arc length along that road's centreline
   CurbProfile profile = CurbProfile::vertical;
   double nominal_height = 0;   // the curb's reveal here without any cut, m
   double height = 0;           // as built: 0 inside a cut, tapering over the flares
   std::optional<CurbCut> cut;  // set where the curb is fully cut
   double gutter_width = 0, gutter_slope = 0;
   double sidewalk_width = 0;
-  double bottom_z = 0;         // the face's foot (the gutter's low edge)
-  double terrain_z = 0;        // the terrain's height at `point`
+  double bottom_z = 0;   // the face's foot (the gutter's low edge)
+  double terrain_z = 0;  // the terrain's height at `point`
 };
 
 // The band's widths, the same along every curb so the regions beside it can be cut once: it spans
@@ -82,8 +82,8 @@ class RaisedGround {
 };
 
 // Triangles of the band: pavement up to each gutter's lip, gutter pan, curb face and top.
-void mesh_curb_band(const RaisedGround& raised, const RoadSurface& surface, CurbBandWidths widths,
-                    MaterialId pavement, MaterialId concrete, TriangleMesh& mesh);
+void mesh_curb_band(const RaisedGround& raised, const RoadSurface& surface, CurbBandWidths widths, MaterialId pavement,
+                    MaterialId concrete, TriangleMesh& mesh);
 
 // The curb lines of the map: each ring split where its kind changes (a profile, or a cut's kind), with
 // the kind of each line.

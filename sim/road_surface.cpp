@@ -10,11 +10,11 @@
 namespace lidarloop {
 namespace {
 
-constexpr double kSampleStep = 0.5;     // m between centreline samples
-constexpr size_t kNearestSamples = 4;   // enough to see two roads at once where they meet
-constexpr size_t kNearestCandidates = 16;   // samples weighed when attributing a point to a road
-constexpr double kBeyondEndPenalty = 1.0;   // m added to the distance past an open road's end
-constexpr int kRoughnessWaves = 32;     // plane waves summed for the roughness field
+constexpr double kSampleStep = 0.5;             // m between centreline samples
+constexpr size_t kNearestSamples = 4;           // enough to see two roads at once where they meet
+constexpr size_t kNearestCandidates = 16;       // samples weighed when attributing a point to a road
+constexpr double kBeyondEndPenalty = 1.0;       // m added to the distance past an open road's end
+constexpr int kRoughnessWaves = 32;             // plane waves summed for the roughness field
 constexpr double kIsoReferenceFrequency = 0.1;  // cycles/m, n0 of ISO 8608
 constexpr double kIsoWaviness = 2.0;            // w of ISO 8608: G(n) = G(n0) (n / n0)^-w
 
@@ -124,8 +124,8 @@ double RoadSurface::crown(const Eigen::Vector2d& p) const {
     const Sample& s = samples_[idx[k]];
     const Eigen::Vector2d d = p - points_[idx[k]];
     const double along = d.dot(s.tangent);
-    const double distance = std::abs(along) <= kSampleStep ? std::abs(lateral_offset(p, points_[idx[k]], s.tangent))
-                                                           : std::sqrt(d2[k]);
+    const double distance =
+        std::abs(along) <= kSampleStep ? std::abs(lateral_offset(p, points_[idx[k]], s.tangent)) : std::sqrt(d2[k]);
     z = std::max(z, -cross_slope_[size_t(s.road)] * distance);
   }
   return found ? z : 0.0;

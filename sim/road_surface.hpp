@@ -18,10 +18,10 @@ struct PointsKdTree;
 
 // Where a point lies relative to the nearest road centreline.
 struct RoadPoint {
-  int road = -1;         // index into WorldDescription::roads
-  double s = 0;          // arc length along the centreline, m
-  double lateral = 0;    // signed offset, left of the centreline's direction positive, m
-  double distance = 0;   // from the centreline, m (= |lateral| beside the road, more past its ends)
+  int road = -1;        // index into WorldDescription::roads
+  double s = 0;         // arc length along the centreline, m
+  double lateral = 0;   // signed offset, left of the centreline's direction positive, m
+  double distance = 0;  // from the centreline, m (= |lateral| beside the road, more past its ends)
   Eigen::Vector2d tangent{1, 0};
 };
 
@@ -32,9 +32,9 @@ class RoadSurface {
   RoadSurface(const RoadSurface&) = delete;
   RoadSurface& operator=(const RoadSurface&) = delete;
 
-  double terrain(const Eigen::Vector2d& p) const;     // hills
-  double crown(const Eigen::Vector2d& p) const;       // <= 0: the fall from the nearest crown line
-  double roughness(const Eigen::Vector2d& p) const;   // zero-mean pavement unevenness
+  double terrain(const Eigen::Vector2d& p) const;    // hills
+  double crown(const Eigen::Vector2d& p) const;      // <= 0: the fall from the nearest crown line
+  double roughness(const Eigen::Vector2d& p) const;  // zero-mean pavement unevenness
   double carriageway(const Eigen::Vector2d& p) const { return terrain(p) + crown(p) + roughness(p); }
   RoadPoint nearest_road(const Eigen::Vector2d& p) const;
 

@@ -4,11 +4,13 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "localizer/curb_detector.hpp"
+#include "localizer/obstacle_rejection.hpp"
 #include "reference_curb_detector.hpp"
 #include "sim/actor_assets.hpp"
 #include "sim/lidar_scanner.hpp"
@@ -78,7 +80,10 @@ Detection detect_on_straight(double x, const Traffic& traffic = {}) {
   const GroundHeight pavement = w.world.pavement();
   const Eigen::Isometry3d vehicle = rest_on_ground({x, -2.25, 0}, pavement, car.wheelbase(), car.track_width);
   const VehicleScan scan = scan_from(scene, vehicle, 9);
-  const auto curbs = detect_curbs(scan.points, scan.rings, CurbDetectorParams{});
+  // As the localizer does: heights above the scan's ground plane (2.1.2), so a rolled car sees level.
+  const ObstacleSplit split = reject_obstacles(scan.points, ObstacleParams{});
+  const auto curbs =
+      detect_curbs(split.plane_ok ? level_to_plane(scan.points, split.plane) : scan.points, scan.rings, {});
   Detection d;
   constexpr double kTolerance = 0.3;  // m from the true curb line
   for (const auto& c : curbs) {
@@ -89,27 +94,30 @@ Detection detect_on_straight(double x, const Traffic& traffic = {}) {
       best = std::min(best, (sample_polyline(line, project_onto_polyline(line, world)).point - world).norm());
     d.correct += best < kTolerance;
   }
-  // Recall: where each ground ring's circle crosses the two straight curbs, within 15 m, unless
-  // something stands between the sensor and that point (a parked coach hides the curb behind it).
-  const double height = config.mount_xyz.z();
-  const Eigen::Vector3d sensor = vehicle * config.mount().translation();
-  auto visible = [&](const Eigen::Vector2d& p) {
-    constexpr double kNearTarget = 0.5;  // m: hits this close to the curb are the curb or the road by it
-    const Eigen::Vector3d to = Eigen::Vector3d(p.x(), p.y(), pavement(p)) - sensor;
-    const Ray ray{sensor.cast<float>(), to.normalized().cast<float>()};
-    RayHit hit;
-    return !scene.intersect(ray, 0.0f, float(to.norm() - kNearTarget), hit);
-  };
+  // Recall: where each downward laser's sweep reaches the foot of the two straight curbs within 15 m,
+  // found by casting its rays (a parked coach hides the curb behind it; a rolled car's rings are not
+  // circles).
+  const Eigen::Isometry3d sensor = vehicle * config.mount();
+  constexpr double kAzimuthStep = 0.001;  // rad
   for (int ring = 0; ring < 32; ++ring) {
     const double elevation = config.elevation_deg[ring] * M_PI / 180;
     if (elevation >= 0) continue;
-    const double r = height / std::tan(-elevation);
-    for (double curb_y : {-4.5, 4.5}) {
-      const double dy = curb_y - (-2.25), sensor_dx = config.mount_xyz.x();
-      if (r <= std::abs(dy) || r > 15) continue;
-      for (double sign : {-1.0, 1.0}) {
-        const Eigen::Vector2d expected(x + sensor_dx + sign * std::sqrt(r * r - dy * dy), curb_y);
-        if (!visible(expected)) continue;
+    std::optional<Eigen::Vector3d> last;
+    for (double a = 0; a < 2 * M_PI; a += kAzimuthStep) {
+      const Eigen::Vector3d dir =
+          sensor.linear() *
+          Eigen::Vector3d(std::cos(elevation) * std::cos(a), std::cos(elevation) * std::sin(a), std::sin(elevation));
+      RayHit hit;
+      const Ray ray{sensor.translation().cast<float>(), dir.cast<float>()};
+      std::optional<Eigen::Vector3d> p;
+      if (scene.intersect(ray, 0.0f, 40.0f, hit)) p = sensor.translation() + dir * double(hit.range);
+      for (double curb_y : {-4.5, 4.5}) {
+        if (!p || !last || (p->y() - curb_y) * (last->y() - curb_y) > 0) continue;
+        // The ray sweeps across the curb line there: on the ground near the curb, within reach.
+        if (std::abs(p->z() - pavement(p->head<2>())) > 0.3 ||
+            (p->head<2>() - vehicle.translation().head<2>()).norm() > 15)
+          continue;
+        const Eigen::Vector2d expected(p->x(), curb_y);
         ++d.expected;
         for (const auto& c : curbs)
           if (((vehicle * Eigen::Vector3d(c.x(), c.y(), 0)).head<2>() - expected).norm() < 2 * kTolerance) {
@@ -117,6 +125,7 @@ Detection detect_on_straight(double x, const Traffic& traffic = {}) {
             break;
           }
       }
+      last = p;
     }
   }
   return d;
