@@ -3,6 +3,11 @@
 // ring, a curb shows up as a short, steep rise of 5-30 cm between two flat stretches (the road and the
 // sidewalk). The detected point is the foot of the rise: the road's edge, which is what the curb map
 // records.
+//
+// Beyond the paper: the flat stretches may tilt (a crowned road, a sidewalk's cross-fall, a gutter
+// pan), and the rise is read where each of them, carried along its own tilt, meets the step. Read
+// between the stretches' medians, as the paper's window statistics do, a slope that runs on through
+// both stretches (the 1:10 flares beside a curb ramp, a driveway apron) passes for a curb.
 #include <vector>
 
 #include <Eigen/Core>
@@ -12,7 +17,7 @@
 namespace lidarloop {
 
 struct CurbDetectorParams {
-  double min_height = 0.05;          // m: lower steps are road texture or noise
+  double min_height = 0.05;          // m at the step's ends: lower steps are road texture or noise
   double max_height = 0.30;          // m: higher steps are walls, cars, people
   double step_length = 0.40;         // m along the ring over which the rise must happen
   double flat_length = 0.50;         // m of ring on each side that must be flat

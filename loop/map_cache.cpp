@@ -20,8 +20,8 @@ namespace fs = std::filesystem;
 
 constexpr uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3ULL;
 // Bump when the mapping drive changes what it produces. 2: the map is a survey (pose error, its own
-// HDL-32E unit, curbs moved by the survey error).
-constexpr int kMapFormatVersion = 2;
+// HDL-32E unit, curbs moved by the survey error). 3: the survey car rests on the crowned road.
+constexpr int kMapFormatVersion = 3;
 
 static void hash_bytes(uint64_t& h, const std::string& bytes) {
   for (unsigned char c : bytes) h = (h ^ c) * kFnvPrime;

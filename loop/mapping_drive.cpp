@@ -7,7 +7,9 @@
 #include "sim/actor_assets.hpp"
 #include "sim/lidar_scanner.hpp"
 #include "sim/path.hpp"
+#include "sim/road_surface.hpp"
 #include "sim/traffic.hpp"
+#include "sim/vehicle_model.hpp"
 
 namespace lidarloop {
 
@@ -68,6 +70,8 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
   lidar.unit_serial = o.survey_unit_serial;
   const LidarScanner scanner(lidar, materials);
   const Eigen::Isometry3d mount = lidar.mount();
+  const GroundHeight pavement = world.pavement();
+  const VehicleParams survey_car;
   const int64_t period = lidar.scan_period_ns();
   const SurveyDrive survey = mapping_survey(description, o);
 
@@ -89,11 +93,18 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
       add_actors(scene, traffic, actors_dir, materials);
     }
     const ActorPoses actor_poses = actor_motion(traffic);
-    // The car is where the truth says; its scans are placed where the survey says.
-    const PoseAt vehicle = [&](int64_t t) { return to_isometry(path.pose_at(o.speed * ns_to_s(t))); };
+    // The car is where the truth says, resting on the crowned, rough road; its scans are placed where
+    // the survey says: the survey's plan position and heading error moves the whole body.
+    const PoseAt vehicle = [&](int64_t t) {
+      return rest_on_ground(path.pose_at(o.speed * ns_to_s(t)), pavement, survey_car.wheelbase(),
+                            survey_car.track_width);
+    };
     const PoseAt surveyed = [&](int64_t t) {
       const double s = o.speed * ns_to_s(t);
-      return to_isometry(surveyed_pose(path.pose_at(s), survey.error.at(lane.start_m + s)));
+      const Pose2d truth = path.pose_at(s);
+      const Eigen::Isometry3d error =
+          to_isometry(surveyed_pose(truth, survey.error.at(lane.start_m + s))) * to_isometry(truth).inverse();
+      return error * vehicle(t);
     };
     const int64_t scans = int64_t(path.length / o.speed / (double(period) * 1e-9));
     for (int64_t k = 0; k < scans; ++k) {
@@ -101,19 +112,16 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
       const PointCloud cloud = scanner.scan(scene, vehicle, stamp, o.seed, actor_poses);
       // The survey places each point with its pose at the point's own firing cycle.
       uint32_t cycle = UINT32_MAX;
-      Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
-      // The survey car is level: a point higher than this in the sensor frame cannot be ground.
-      const double max_sensor_z = o.max_ground_height - lidar.mount_xyz.z();
+      Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
       for (const LidarPoint& p : cloud.points) {
-        if (p.z > max_sensor_z || double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z > o.max_range * o.max_range)
-          continue;
-        const uint32_t c = uint32_t(p.t_ns / lidar.cycle_period_ns());
-        if (c != cycle) cycle = c, sensor = surveyed(stamp + int64_t(c) * lidar.cycle_period_ns()) * mount;
+        if (double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z > o.max_range * o.max_range) continue;
         if (p.intensity > 100) continue;  // a sign or a reflector, not the road surface
-        const Eigen::Vector3d local(p.x, p.y, p.z);
-        const Eigen::Vector3d w = sensor * local;
-        if (w.z() > o.max_ground_height) continue;
-        builder.add(w.head<2>(), p.intensity);
+        // Higher than this above the plane the car's wheels stand on, a point cannot be ground.
+        const Eigen::Vector3d v = mount * Eigen::Vector3d(p.x, p.y, p.z);
+        if (v.z() > o.max_ground_height) continue;
+        const uint32_t c = uint32_t(p.t_ns / lidar.cycle_period_ns());
+        if (c != cycle) cycle = c, body = surveyed(stamp + int64_t(c) * lidar.cycle_period_ns());
+        builder.add((body * v).head<2>(), p.intensity);
       }
       if (progress) progress((lane.start_m + o.speed * ns_to_s(stamp)) / survey.length_m);
     }

@@ -32,7 +32,8 @@ std::vector<Cut> cuts_of(const WorldDescription& d, int road, RoadSide side) {
   for (const auto& c : d.curb_cuts)
     if (c.road == r.name && c.side == side) out.push_back({c.at - c.length / 2, c.at + c.length / 2, c.kind});
   for (const auto& c : d.crosswalks)
-    if (c.road == r.name) out.push_back({c.at - c.width / 2, c.at + c.width / 2, CurbCut::ramp});
+    if (d.geometry.crosswalk_ramps && c.road == r.name)
+      out.push_back({c.at - c.width / 2, c.at + c.width / 2, CurbCut::ramp});
   if (r.driveway_spacing > 0) {
     const double length = polyline_length(r.centreline);
     for (double s = r.driveway_spacing / 2; s + r.driveway_width / 2 < length; s += r.driveway_spacing) {

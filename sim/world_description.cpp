@@ -186,7 +186,8 @@ WorldDescription parse(const YamlReader& y) {
       .number("flare_slope", g.flare_slope, 0.01, 0.5)
       .number("roughness_min_wavelength", g.roughness_min_wavelength, 0.1, 100.0)
       .number("roughness_max_wavelength", g.roughness_max_wavelength, 0.1, 1000.0)
-      .integer("roughness_seed", g.roughness_seed, 0, uint64_t(1) << 62);
+      .integer("roughness_seed", g.roughness_seed, 0, uint64_t(1) << 62)
+      .boolean("crosswalk_ramps", g.crosswalk_ramps);
   if (const YAML::Node c = geometry["roughness_class"]) {
     const std::string s = y.string(c, "roughness_class");
     if (s != "none" && (s.size() != 1 || s[0] < 'A' || s[0] > 'E'))
@@ -289,6 +290,22 @@ const RoadSpec* WorldDescription::road(const std::string& name) const {
   for (const auto& r : roads)
     if (r.name == name) return &r;
   return nullptr;
+}
+
+WorldDescription on_ideal_ground(WorldDescription d) {
+  d.geometry.sidewalk_cross_slope = 0;
+  d.geometry.roughness_class = '-';
+  d.geometry.crosswalk_ramps = false;
+  d.hills.clear();
+  d.curb_cuts.clear();
+  for (RoadSpec& r : d.roads) {
+    r.cross_slope = 0;
+    r.curb_profile = CurbProfile::vertical;
+    r.curb_height_variation = 0;
+    r.gutter_width = 0;
+    r.driveway_spacing = 0;
+  }
+  return d;
 }
 
 WorldDescription load_world_description(const std::string& path) { return parse(YamlReader::open(path)); }

@@ -129,6 +129,7 @@ struct WorldGeometryParams {
   char roughness_class = 'B';                                              // or '-' for a perfectly smooth pavement
   double roughness_min_wavelength = 0.5, roughness_max_wavelength = 10.0;  // m
   uint64_t roughness_seed = 1;
+  bool crosswalk_ramps = true;  // every crosswalk gets a curb ramp on both sides (ADA 406)
 };
 
 struct WorldDescription {
@@ -149,6 +150,10 @@ struct WorldDescription {
 };
 
 WorldDescription load_world_description(const std::string& path);
+// The same world on ideal ground, as this project built every world before its roads had realism:
+// level smooth carriageways and sidewalks, no hills, uniform vertical curbs without gutters or cuts.
+// For tests that need known, clean geometry; scenarios never use it.
+WorldDescription on_ideal_ground(WorldDescription d);
 WorldDescription parse_world_description(const std::string& yaml_text, const std::string& name);
 
 }  // namespace lidarloop

@@ -1,7 +1,8 @@
 // The oracle for localizer/curb_detector.cpp: see reference_curb_detector.hpp. This is that file as it
 // stood before commit 0235f81 (git show 0235f81^:localizer/curb_detector.cpp), with only its namespace,
-// its function's name and clang-format's line breaks changed: keep it that way. Below it, the
-// comparison the tests make with it.
+// its function's name and clang-format's line breaks changed, and one change of behaviour made in both
+// detectors since: the rise is read where each flat stretch, carried along its own tilt, meets the
+// step (half_median_slope). Below it, the comparison the tests make with it.
 #include "reference_curb_detector.hpp"
 
 #include <algorithm>
@@ -81,10 +82,28 @@ std::vector<long> reach(const Ring& r, double length, bool forward) {
 
 struct Stretch {
   double median_z, sigma_z;
+  double slope, mid_s;  // dz/ds along the ring, and the arc length the median stands for
+
+  double height_at(double s) const { return median_z + slope * (s - mid_s); }
 };
 
-// Height statistics of ring points [a, b] (either order): median (robust to a stray return) and the
-// spread about it.
+// The tilt of ring points [a, b] (a < b): from the medians of its two halves, so the few points of
+// a curb face at the stretch's end do not tilt it.
+double half_median_slope(const Ring& r, size_t a, size_t b, std::vector<double>& scratch) {
+  if (b - a < 3) return 0;
+  const size_t m = a + (b - a) / 2;  // the first half is [a, m], the second [m + 1, b]
+  auto median_z = [&](size_t from, size_t to) {
+    scratch.clear();
+    for (size_t k = from; k <= to; ++k) scratch.push_back(r.p[k]->z());
+    std::nth_element(scratch.begin(), scratch.begin() + long(scratch.size() / 2), scratch.end());
+    return scratch[scratch.size() / 2];
+  };
+  const double run = (r.s[m + 1] + r.s[b]) / 2 - (r.s[a] + r.s[m]) / 2;
+  return run > 0 ? (median_z(m + 1, b) - median_z(a, m)) / run : 0.0;
+}
+
+// Height statistics of ring points [a, b] (either order): median (robust to a stray return), the
+// spread about it, and the tilt, so the rise is read where each stretch meets the step.
 Stretch stretch(const Ring& r, size_t a, size_t b, std::vector<double>& scratch) {
   if (a > b) std::swap(a, b);
   scratch.clear();
@@ -93,7 +112,8 @@ Stretch stretch(const Ring& r, size_t a, size_t b, std::vector<double>& scratch)
   const double median = scratch[scratch.size() / 2];
   double sum2 = 0;
   for (double v : scratch) sum2 += (v - median) * (v - median);
-  return {median, std::sqrt(sum2 / double(scratch.size()))};
+  const double sigma = std::sqrt(sum2 / double(scratch.size()));
+  return {median, sigma, half_median_slope(r, a, b, scratch), (r.s[a] + r.s[b]) / 2};
 }
 
 }  // namespace
@@ -136,7 +156,7 @@ std::vector<Eigen::Vector2d> reference_detect_curbs(const std::vector<Eigen::Vec
         // Road before i, sidewalk after the rise: both flat, the sidewalk a curb's height higher.
         const Stretch road = stretch(ring, size_t(before), i, scratch);
         const Stretch walkway = stretch(ring, size_t(top), size_t(after), scratch);
-        const double rise = walkway.median_z - road.median_z;
+        const double rise = walkway.height_at(ring.s[size_t(top)]) - road.height_at(ring.s[i]);
         if (rise < p.min_height || rise > p.max_height) continue;
         if (road.sigma_z > p.max_flat_roughness || walkway.sigma_z > p.max_flat_roughness) continue;
         // The foot of the rise: the last point still at road height.
