@@ -6,6 +6,7 @@
 
 #include "common/points_kd_tree.hpp"
 #include "sim/polyline.hpp"
+#include "sim/superelevation.hpp"
 
 namespace lidarloop {
 namespace {
@@ -38,11 +39,16 @@ RoadSurface::RoadSurface(const WorldDescription& d) : hills_(d.hills) {
     cross_slope_.push_back(road.cross_slope);
     const double length = polyline_length(road.centreline);
     const int n = std::max(1, int(std::ceil(length / kSampleStep)));
+    std::vector<double> arc;
+    for (int i = 0; i <= n; ++i) arc.push_back(length * i / n);
+    const std::vector<double> bank =
+        superelevation_profile(road.centreline, road.closed, arc, road.design_speed, road.cross_slope,
+                               d.geometry.max_superelevation, road.width / 2);
     for (int i = 0; i <= n; ++i) {
-      const double s = length * i / n;
-      const PolylineSample at = sample_polyline(road.centreline, s);
+      const PolylineSample at = sample_polyline(road.centreline, arc[size_t(i)]);
       points_.push_back(at.point);
-      samples_.push_back({int(r), s, at.tangent, i == 0 && !road.closed, i == n && !road.closed});
+      samples_.push_back(
+          {int(r), arc[size_t(i)], at.tangent, i == 0 && !road.closed, i == n && !road.closed, bank[size_t(i)]});
     }
   }
   index_ = std::make_unique<PointsKdTree>(&points_);
@@ -113,8 +119,8 @@ RoadPoint RoadSurface::nearest_road(const Eigen::Vector2d& p) const {
   return best;
 }
 
-// Each road's crown falls linearly from its centreline; where roads meet, the highest of their
-// surfaces is the pavement, so the surface stays continuous through intersections.
+// Each road's crown falls linearly from its centreline, or is banked through a curve; where roads meet,
+// the highest of their surfaces is the pavement, so the surface stays continuous through intersections.
 double RoadSurface::crown(const Eigen::Vector2d& p) const {
   std::array<uint32_t, kNearestSamples> idx{};
   std::array<double, kNearestSamples> d2{};
@@ -124,9 +130,11 @@ double RoadSurface::crown(const Eigen::Vector2d& p) const {
     const Sample& s = samples_[idx[k]];
     const Eigen::Vector2d d = p - points_[idx[k]];
     const double along = d.dot(s.tangent);
-    const double distance =
-        std::abs(along) <= kSampleStep ? std::abs(lateral_offset(p, points_[idx[k]], s.tangent)) : std::sqrt(d2[k]);
-    z = std::max(z, -cross_slope_[size_t(s.road)] * distance);
+    // Beside the sample, the offset across the road; farther along (past an open road's end), the
+    // distance, on the side the point is.
+    const double lateral = lateral_offset(p, points_[idx[k]], s.tangent);
+    const double offset = std::abs(along) <= kSampleStep ? lateral : std::copysign(std::sqrt(d2[k]), lateral);
+    z = std::max(z, banked_section(offset, cross_slope_[size_t(s.road)], s.bank));
   }
   return found ? z : 0.0;
 }

@@ -1,7 +1,8 @@
 #pragma once
 // The height of the ground a world is built on, before curbs: the terrain (hills give roads their
-// grade), the carriageway's crown (it falls from each road's centreline towards its curbs) and the
-// pavement's roughness. The world builder meshes these heights; vehicles rest on them.
+// grade), the carriageway's crown (it falls from each road's centreline towards its curbs) or, through
+// curves, its superelevation, and the pavement's roughness. The world builder meshes these heights; vehicles rest on
+// them.
 #include <functional>
 #include <memory>
 #include <vector>
@@ -33,7 +34,7 @@ class RoadSurface {
   RoadSurface& operator=(const RoadSurface&) = delete;
 
   double terrain(const Eigen::Vector2d& p) const;    // hills
-  double crown(const Eigen::Vector2d& p) const;      // <= 0: the fall from the nearest crown line
+  double crown(const Eigen::Vector2d& p) const;      // the crown's fall, or the curve's bank, from the centreline
   double roughness(const Eigen::Vector2d& p) const;  // zero-mean pavement unevenness
   double carriageway(const Eigen::Vector2d& p) const { return terrain(p) + crown(p) + roughness(p); }
   RoadPoint nearest_road(const Eigen::Vector2d& p) const;
@@ -44,6 +45,7 @@ class RoadSurface {
     double s;
     Eigen::Vector2d tangent;
     bool at_start, at_end;  // the first or last sample of an open road
+    double bank;            // superelevation, signed: positive banks towards the left
   };
   struct Wave {
     Eigen::Vector2d wavenumber;  // rad/m

@@ -57,6 +57,7 @@ void read_road_properties(YamlMap& m, RoadSpec& road) {
       .number("sidewalk_width", road.sidewalk_width, 0.0, 15.0)
       .number("smoothing_radius", road.smoothing_radius, 0.0, 500.0)
       .number("cross_slope", road.cross_slope, 0.0, 0.08)
+      .number("design_speed", road.design_speed, 5.0, 130.0)
       .number("curb_height_variation", road.curb_height_variation, 0.0, 0.1)
       .number("gutter_width", road.gutter_width, 0.0, 1.8)
       .number("gutter_slope", road.gutter_slope, 0.0, 0.12)
@@ -184,6 +185,7 @@ WorldDescription parse(const YamlReader& y) {
       .number("sidewalk_cross_slope", g.sidewalk_cross_slope, 0.0, 0.1)
       .number("ramp_slope", g.ramp_slope, 0.01, 0.5)
       .number("flare_slope", g.flare_slope, 0.01, 0.5)
+      .number("max_superelevation", g.max_superelevation, 0.0, 0.12)
       .number("roughness_min_wavelength", g.roughness_min_wavelength, 0.1, 100.0)
       .number("roughness_max_wavelength", g.roughness_max_wavelength, 0.1, 1000.0)
       .integer("roughness_seed", g.roughness_seed, 0, uint64_t(1) << 62)
@@ -296,6 +298,7 @@ WorldDescription on_ideal_ground(WorldDescription d) {
   d.geometry.sidewalk_cross_slope = 0;
   d.geometry.roughness_class = '-';
   d.geometry.crosswalk_ramps = false;
+  d.geometry.max_superelevation = 0;
   d.hills.clear();
   d.curb_cuts.clear();
   for (RoadSpec& r : d.roads) {

@@ -48,6 +48,9 @@ struct RoadSpec {
   double gutter_slope = 0.06;
   double driveway_spacing = 0;  // m between driveway cuts along each side; 0 = none
   double driveway_width = 4.0;  // m, at the curb line
+  // km/h: sets the superelevation of its curves (sim/superelevation.hpp); a campus street's 30 km/h
+  // asks for none on a 40 m radius.
+  double design_speed = 30;
 };
 
 struct CrosswalkSpec {
@@ -129,7 +132,9 @@ struct WorldGeometryParams {
   char roughness_class = 'B';                                              // or '-' for a perfectly smooth pavement
   double roughness_min_wavelength = 0.5, roughness_max_wavelength = 10.0;  // m
   uint64_t roughness_seed = 1;
-  bool crosswalk_ramps = true;  // every crosswalk gets a curb ramp on both sides (ADA 406)
+  bool crosswalk_ramps = true;
+  // Curves are banked at most this much: AASHTO 2011 3.3.3, 4 % for urban streets (ice, slow traffic).
+  double max_superelevation = 0.04;  // every crosswalk gets a curb ramp on both sides (ADA 406)
 };
 
 struct WorldDescription {

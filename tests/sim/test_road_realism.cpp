@@ -12,6 +12,7 @@
 #include "sim/lidar_scanner.hpp"
 #include "sim/polyline.hpp"
 #include "sim/road_surface.hpp"
+#include "sim/superelevation.hpp"
 #include "test_support.hpp"
 
 namespace lidarloop {
@@ -157,6 +158,56 @@ TEST(RoadRealism, CurbLinesNameTheirKindsAndCuts) {
   for (double l : lengths["driveway"]) EXPECT_NEAR(l, 5.0, 0.6);
   EXPECT_FALSE(lengths["sloped"].empty());
   EXPECT_TRUE(lengths["vertical"].empty());
+}
+
+}  // namespace
+}  // namespace lidarloop
+
+namespace lidarloop {
+namespace {
+
+TEST(RoadRealism, CurvesAreBankedOnlyWhereTheirDesignSpeedNeedsIt) {
+  // AASHTO's low-speed method: V^2 / (127 R) - f. A 40 m curve needs nothing at 30 km/h (0.177 < 0.28)
+  // and more than the 4 % cap at 50 km/h (0.49 - 0.19); a bank below the crown's slope is raised to it.
+  EXPECT_EQ(superelevation_rate(40, 30, 0.02, 0.04), 0.0);
+  EXPECT_DOUBLE_EQ(superelevation_rate(40, 50, 0.02, 0.04), 0.04);
+  EXPECT_DOUBLE_EQ(superelevation_rate(95, 50, 0.02, 0.04), 0.02);  // 0.207 - 0.19 = 0.017 < 0.02
+  EXPECT_EQ(superelevation_rate(40, 50, 0.02, 0.0), 0.0);
+}
+
+TEST(RoadRealism, ACurveIsBankedTowardsItsInsideAndRunsOffAtTheMaximumRelativeGradient) {
+  // A left-hand quarter turn of 60 m radius at 50 km/h between two 200 m straights: the bank is the
+  // 4 % cap through the arc, the normal 2 % crown on the straights far from it, and the pavement edge
+  // climbs relative to the centreline at most at AASHTO's 0.65 % between them.
+  constexpr double kRadius = 60, kHalfWidth = 4.5, kCross = 0.02, kCap = 0.04;
+  const World w = test::world_from_yaml(kHeader +
+                                        "geometry: {roughness_class: none}\nroads:\n  - {name: r, points: [[-200, 0], "
+                                        "[100, 0], [100, 300]], width: 9, design_speed: 50, smoothing_radius: " +
+                                        std::to_string(kRadius) + "}\n");
+  const GroundHeight ground = w.pavement();
+  // Mid-arc: the centre of the fillet is (100 - R, R); its mid-point lies at 45 deg.
+  const Eigen::Vector2d centre(100 - kRadius, kRadius), radial(std::sqrt(0.5), -std::sqrt(0.5));
+  const Eigen::Vector2d mid = centre + kRadius * radial;
+  auto across = [&](const Eigen::Vector2d& at, const Eigen::Vector2d& outward, double l) {
+    return ground(at + l * outward) - ground(at);
+  };
+  // Inside (towards the centre) falls at the cap, the outside rises at it.
+  EXPECT_NEAR(across(mid, -radial, 4.0) / 4.0, -kCap, 0.001);
+  EXPECT_NEAR(across(mid, radial, 4.0) / 4.0, kCap, 0.001);
+  // Far along the first straight: the normal crown on both sides.
+  EXPECT_NEAR(across({-150, 0}, {0, 1}, 4.0) / 4.0, -kCross, 0.001);
+  EXPECT_NEAR(across({-150, 0}, {0, -1}, 4.0) / 4.0, -kCross, 0.001);
+  // The outer edge's height relative to the centreline along the straight into the curve.
+  const double gradient = max_relative_gradient(50);
+  // Over 5 m: the bank is held per 0.5 m centreline sample, so shorter differences see its steps.
+  constexpr double kBase = 5.0;
+  double steepest = 0;
+  for (double x = -100; x + kBase <= 100 - kRadius; x += 0.5) {
+    const double rise = across({x + kBase, 0}, {0, -1}, kHalfWidth) - across({x, 0}, {0, -1}, kHalfWidth);
+    steepest = std::max(steepest, std::abs(rise) / kBase);
+  }
+  EXPECT_GT(steepest, 0.5 * gradient);   // it does run off along here
+  EXPECT_LE(steepest, gradient * 1.05);  // and no steeper than allowed
 }
 
 }  // namespace
