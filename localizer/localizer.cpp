@@ -465,11 +465,22 @@ void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
   // carries no information (a solid line along the road and nothing marking the position along it);
   // its centre of mass only follows the map's noise and the window's edges, and a drift it starts is
   // never taken back. Such an axis is left to the other sensors.
+  // Where the window was grown to the prior's spread (a cold start, GPS alone), it must also be no
+  // wider than what the filter already believes: a broad bump of map noise in the wide window looked
+  // informative against the window while it said less than GPS (intersections: a first match 3 m
+  // off moved the car 1.45 m).
   const bool curbs_hold_lateral =
       params_.aps_longitudinal_only_with_curbs && e.curb_observation && !(e.health & kCurbMatchRejected);
-  const bool along = aps.spread_ratio.x() <= params_.aps_max_spread_ratio;
-  const bool across = aps.spread_ratio.y() <= params_.aps_max_spread_ratio && !curbs_hold_lateral;
   const Eigen::Vector2d forward(std::cos(prior.yaw), std::sin(prior.yaw)), left(-forward.y(), forward.x());
+  const Eigen::Matrix2d P = filter_->covariance().topLeftCorner<2, 2>();
+  auto informative = [&](int axis, const Eigen::Vector2d& u, double paper_range) {
+    const double prior_variance = u.dot(P * u);
+    const bool grown = params_.aps_window_sigmas * std::sqrt(prior_variance) > paper_range;
+    return aps.spread_ratio[axis] <= params_.aps_max_spread_ratio &&
+           (!grown || u.dot(aps.covariance * u) <= prior_variance);
+  };
+  const bool along = informative(0, forward, params_.aps.longitudinal_range_m);
+  const bool across = informative(1, left, params_.aps.lateral_range_m) && !curbs_hold_lateral;
   if (along && across)
     filter_->update_intensity(aps.position, R);  // KF2
   else if (along || across)

@@ -9,7 +9,7 @@ namespace lidarloop {
 
 LoadedScenario load_scenario_and_world(const std::string& path) {
   Scenario scenario = load_scenario(path, load_vehicle_params(data_dir() + "/assets/vehicle.yaml"));
-  LoadedWorld world = load_world(scenario.world);
+  LoadedWorld world = load_scenario_world(scenario);
   ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
   // The localizer section is the localizer's to check; do it now so that a typo fails before a run.
   localizer_params_for(scenario);

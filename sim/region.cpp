@@ -128,6 +128,12 @@ Paths closing(const Paths& region, double radius) {
 }
 
 std::vector<Polyline2d> clip_lines_outside(const std::vector<Polyline2d>& lines, const Paths& region) {
+  // Clipper's difference with no clip paths returns no open paths at all, not the subject.
+  if (region.empty()) {
+    std::vector<Polyline2d> out;
+    for (const auto& line : lines) out.push_back(to_polyline(to_path(line), false));
+    return out;
+  }
   ClipperLib::Clipper c;
   for (const auto& line : lines) c.AddPath(to_path(line), ClipperLib::ptSubject, false);
   c.AddPaths(region, ClipperLib::ptClip, true);

@@ -214,6 +214,9 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
       }
     }
   }
+  // How today's world differs from the surveyed one: applied, and checked, with the world
+  // (load_scenario_world), since its positions refer to the world's roads.
+  if (const YAML::Node changes = root["world_changes"]) y.expect_map(changes, "world_changes");
   if (const YAML::Node loop = root["loop"]) s.closed_loop = read_choice(y, loop, "loop", "open", "closed");
   YamlMap pass(y, root["pass"], "pass");
   pass.number("lateral_rmse_m", s.pass.lateral_rmse_m, 0.0, 1e4)

@@ -5,6 +5,7 @@
 
 #include "common/input_error.hpp"
 #include "sim/path.hpp"
+#include "sim/scenario.hpp"
 
 namespace lidarloop {
 
@@ -31,6 +32,17 @@ LoadedWorld load_world(const std::string& name_or_path) {
   WorldDescription description = load_world_description(world_file(name_or_path));
   World world = build_world(description, materials, actors_dir());
   return {std::move(materials), std::move(description), std::move(world)};
+}
+
+LoadedWorld load_scenario_world(const Scenario& scenario) {
+  LoadedWorld w = load_world(scenario.world);
+  if (scenario.text.empty()) return w;
+  const YamlReader y = YamlReader::from_string(scenario.text, scenario.file);
+  const YAML::Node changes = y.root().IsMap() ? y.root()["world_changes"] : YAML::Node();
+  if (!changes) return w;
+  w.description = apply_world_changes(std::move(w.description), y, changes);
+  w.world = build_world(w.description, w.materials, actors_dir());
+  return w;
 }
 
 Eigen::Isometry3d default_start_pose(const WorldDescription& description, double s) {

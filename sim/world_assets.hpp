@@ -20,6 +20,11 @@ struct LoadedWorld {
 };
 LoadedWorld load_world(const std::string& name_or_path);
 
+struct Scenario;
+// The world a scenario drives in today: its world file (as the map was surveyed) with the scenario's
+// `world_changes` applied.
+LoadedWorld load_scenario_world(const Scenario& scenario);
+
 // A sensible place to put a car: `s` metres along the first road, in the right-hand lane, heading along it.
 Eigen::Isometry3d default_start_pose(const WorldDescription& description, double s = 20.0);
 

@@ -19,6 +19,15 @@ constexpr double kCurbStation = 0.5;      // m between cross-sections of the cur
 constexpr double kPaintPiece = 0.5;       // m; paint is draped over the pavement in pieces this long
 constexpr double kIntersectionPad = 2.0;  // m beyond the corner radius where lane paint stops
 constexpr double kCrosswalkPad = 1.0;     // m before a crosswalk where lane paint stops
+// Work zones. Cones: MUTCD (2009) 6F.64, at least 28 in (0.71 m) tall, with a retro-reflective band for
+// night use; spaced in feet at about the speed in mph (6C.08: 30 km/h ~ 20 mph ~ 6 m), 0.3 m inside
+// the closed side. Barriers: the New Jersey / F-shape concrete safety barrier, 32 in (0.81 m) tall,
+// 24 in (0.61 m) at its base, in 12.5 ft (3.8 m) segments.
+constexpr double kConeSpacing = 6.0, kConeInset = 0.3;                                                   // m
+constexpr float kConeHeight = 0.71f, kConeBaseRadius = 0.18f, kConeTopRadius = 0.03f;                    // m
+constexpr float kBandLow = 0.40f, kBandHigh = 0.55f, kBandRadiusLow = 0.105f, kBandRadiusHigh = 0.075f;  // m
+constexpr double kBarrierLength = 3.8, kBarrierJoint = 0.05;         // m; a barrier segment and half the gap between
+constexpr float kBarrierHeight = 0.81f, kBarrierHalfWidth = 0.305f;  // m
 
 Eigen::Vector2d left_normal(const Eigen::Vector2d& tangent) { return {-tangent.y(), tangent.x()}; }
 
@@ -51,6 +60,15 @@ void add_paint_line(TriangleMesh& mesh, const Polyline2d& line, double half_widt
 }
 
 // Splits a line into dashes of `dash` metres separated by `gap` metres.
+// The part of a centreline within length/2 of arc length `at`, sampled every kPaintPiece.
+Polyline2d stretch_of(const Polyline2d& centreline, double at, double length) {
+  const double from = std::max(0.0, at - length / 2), to = std::min(polyline_length(centreline), at + length / 2);
+  Polyline2d out;
+  const int pieces = std::max(1, int(std::ceil((to - from) / kPaintPiece)));
+  for (int k = 0; k <= pieces; ++k) out.push_back(sample_polyline(centreline, from + (to - from) * k / pieces).point);
+  return out;
+}
+
 std::vector<Polyline2d> dashes(const Polyline2d& line, double dash, double gap) {
   std::vector<Polyline2d> out;
   const double len = polyline_length(line);
@@ -177,22 +195,40 @@ struct Builder {
       const double hi = sl.side == RoadSide::right ? 0.0 : road.width / 2 - inset;
       add_paint_line(world.mesh, {s.point + n * lo, s.point + n * hi}, g.stop_line_width / 2, surface, z, lane);
     }
+    // Where the paint changed since the survey (a scenario's world_changes): today's lines there are
+    // gone, or redrawn `shift` to the left.
+    region::Paths changed;
+    for (const auto& c : desc.paint_changes) {
+      const RoadSpec& road = *desc.road(c.road);
+      changed =
+          region::unite(changed, region::strip(stretch_of(road.centreline, c.at, c.length), road.width / 2, false));
+    }
     for (const auto& road : desc.roads) {
-      std::vector<Polyline2d> solid, dashed;
-      auto& dividers = road.marking == MarkingStyle::solid ? solid : dashed;
+      // Lane lines as lateral offsets from the centreline; dashed or solid.
+      std::vector<std::pair<double, bool>> lines;
       if (road.marking != MarkingStyle::none)
         for (int k = 1; k < road.lanes; ++k)
-          dividers.push_back(
-              offset_polyline(road.centreline, -road.width / 2 + k * road.width / road.lanes, road.closed));
+          lines.emplace_back(-road.width / 2 + k * road.width / road.lanes, road.marking == MarkingStyle::dashed);
       if (road.edge_lines)
         for (double side : {-1.0, 1.0})
-          solid.push_back(offset_polyline(
-              road.centreline, side * (road.width / 2 - g.edge_line_inset - road.gutter_width), road.closed));
-      for (const auto& line : region::clip_lines_outside(solid, no_lane_paint))
-        add_paint_line(world.mesh, line, g.paint_width / 2, surface, z, lane);
-      for (const auto& line : region::clip_lines_outside(dashed, no_lane_paint))
-        for (const auto& dash : dashes(line, g.dash_length, g.dash_gap))
-          add_paint_line(world.mesh, dash, g.paint_width / 2, surface, z, lane);
+          lines.emplace_back(side * (road.width / 2 - g.edge_line_inset - road.gutter_width), false);
+      // The pieces of paint as laid out (dashes keep their places along the road), minus `worn`.
+      auto paint = [&](const Polyline2d& centreline, bool closed, double shift, const region::Paths& worn) {
+        for (const auto& [lateral, dashed] : lines) {
+          std::vector<Polyline2d> pieces;
+          for (const auto& line :
+               region::clip_lines_outside({offset_polyline(centreline, lateral + shift, closed)}, no_lane_paint)) {
+            if (!dashed) pieces.push_back(line);
+            if (dashed)
+              for (const auto& dash : dashes(line, g.dash_length, g.dash_gap)) pieces.push_back(dash);
+          }
+          if (!worn.empty()) pieces = region::clip_lines_outside(pieces, worn);
+          for (const auto& piece : pieces) add_paint_line(world.mesh, piece, g.paint_width / 2, surface, z, lane);
+        }
+      };
+      paint(road.centreline, road.closed, 0, changed);
+      for (const auto& c : desc.paint_changes)
+        if (c.road == road.name && c.shift != 0) paint(stretch_of(road.centreline, c.at, c.length), false, c.shift, {});
     }
   }
 
@@ -243,6 +279,31 @@ struct Builder {
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base}, 0.15f, 0.12f, 0.45f * h, 8, leaves);
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base + 0.35f * h}, 0.3f, r, 0.3f * h, 10, leaves);
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base + 0.65f * h}, r, 0.3f, 0.35f * h, 10, leaves);
+      }
+    }
+    // Construction zones (a scenario's world_changes): cones along the closed side's inner edge, with
+    // a retro-reflective band, and concrete barriers down the middle of the closed lanes.
+    const MaterialId cone = mat("traffic_cone"), concrete = mat("curb_concrete");
+    for (const auto& zone : desc.construction) {
+      const RoadSpec& road = *desc.road(zone.road);
+      const double side = zone.side == RoadSide::left ? 1.0 : -1.0;
+      const Polyline2d stretch = stretch_of(road.centreline, zone.at, zone.length);
+      const double length = polyline_length(stretch), lane_middle = side * road.width / 4;
+      for (double s = 0; s <= length; s += kConeSpacing) {
+        const PolylineSample at = sample_polyline(stretch, s);
+        const Eigen::Vector2d p = at.point + left_normal(at.tangent) * side * kConeInset;
+        const float base = float(world.surface->carriageway(p));
+        const Eigen::Vector3f foot(float(p.x()), float(p.y()), base);
+        add_frustum(world.mesh, foot, kConeBaseRadius, kConeTopRadius, kConeHeight, 8, cone);
+        add_frustum(world.mesh, foot + Eigen::Vector3f(0, 0, kBandLow), kBandRadiusLow, kBandRadiusHigh,
+                    kBandHigh - kBandLow, 8, sign);
+      }
+      for (double s = kBarrierLength / 2; s + kBarrierLength / 2 <= length; s += kBarrierLength) {
+        const PolylineSample at = sample_polyline(stretch, s);
+        const Eigen::Vector2d p = at.point + left_normal(at.tangent) * lane_middle;
+        const float base = float(world.surface->carriageway(p));
+        add_box(world.mesh, p.cast<float>(), {float(kBarrierLength / 2 - kBarrierJoint), kBarrierHalfWidth},
+                float(std::atan2(at.tangent.y(), at.tangent.x())), base, base + kBarrierHeight, concrete);
       }
     }
     std::map<std::string, TriangleMesh> meshes;

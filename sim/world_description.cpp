@@ -1,5 +1,6 @@
 #include "sim/world_description.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/units.hpp"
@@ -158,6 +159,20 @@ void check_references(const YamlReader& y, const YAML::Node& root, WorldDescript
   for (size_t i = 0; i < w.trees.size(); ++i) check("trees", i, w.trees[i].road, 0, false);
 }
 
+ParkedVehicleSpec read_parked(YamlMap& m) {
+  const YamlReader& y = m.reader();
+  ParkedVehicleSpec p;
+  p.where = m.where();
+  if (const YAML::Node type = m["type"]) {
+    p.type = y.string(type, "type");
+    if (!actor_type_from_name(p.type))
+      y.fail(type, "unknown vehicle type '" + p.type + "' (expected one of: " + actor_type_names() + ")");
+  }
+  p.position = y.vec2(m.required("position"), "position");
+  m.degrees("yaw_deg", p.yaw, -360.0, 360.0);
+  return p;
+}
+
 WorldDescription parse(const YamlReader& y) {
   YamlMap root(y, y.root(), "a world description");
   WorldDescription w;
@@ -269,18 +284,7 @@ WorldDescription parse(const YamlReader& y) {
     m.number("height", t.height, 2.0, 40.0).number("crown_radius", t.crown_radius, 0.5, 10.0);
     return t;
   });
-  read_list(root, "parked_vehicles", w.parked, [&](YamlMap& m) {
-    ParkedVehicleSpec p;
-    p.where = m.where();
-    if (const YAML::Node type = m["type"]) {
-      p.type = y.string(type, "type");
-      if (!actor_type_from_name(p.type))
-        y.fail(type, "unknown vehicle type '" + p.type + "' (expected one of: " + actor_type_names() + ")");
-    }
-    p.position = y.vec2(m.required("position"), "position");
-    m.degrees("yaw_deg", p.yaw, -360.0, 360.0);
-    return p;
-  });
+  read_list(root, "parked_vehicles", w.parked, [&](YamlMap& m) { return read_parked(m); });
   root.done();
   check_references(y, y.root(), w);
   return w;
@@ -292,6 +296,51 @@ const RoadSpec* WorldDescription::road(const std::string& name) const {
   for (const auto& r : roads)
     if (r.name == name) return &r;
   return nullptr;
+}
+
+WorldDescription apply_world_changes(WorldDescription w, const YamlReader& y, const YAML::Node& changes) {
+  YamlMap root(y, changes, "world_changes");
+  if (const YAML::Node gone = root["parked_vehicles_gone"]) {
+    y.expect_sequence(gone, "parked_vehicles_gone");
+    constexpr double kMatch = 1.0;  // m between a listed position and the parked vehicle's
+    for (const auto& n : gone) {
+      const Eigen::Vector2d at = y.vec2(n, "parked_vehicles_gone");
+      const auto it = std::find_if(w.parked.begin(), w.parked.end(),
+                                   [&](const ParkedVehicleSpec& p) { return (p.position - at).norm() < kMatch; });
+      if (it == w.parked.end()) y.fail(n, "no parked vehicle of world '" + w.name + "' within 1 m of this position");
+      w.parked.erase(it);
+    }
+  }
+  read_list(root, "parked_vehicles_new", w.parked, [&](YamlMap& m) { return read_parked(m); });
+  auto stretch = [&](YamlMap& m, std::string& where, std::string& road, double& at, double& length) {
+    where = m.where();
+    road = y.string(m.required("road"), "road");
+    at = read_station(m, w, road);
+    m.number("length", length, 1.0, 5000.0);
+    const RoadSpec* r = w.road(road);
+    if (!r) y.fail(m.node()["road"], "unknown road '" + road + "'");
+    if (at > polyline_length(r->centreline)) y.fail(m.node(), "beyond the end of road '" + road + "'");
+  };
+  read_list(root, "paint_worn", w.paint_changes, [&](YamlMap& m) {
+    PaintChange c;
+    stretch(m, c.where, c.road, c.at, c.length);
+    return c;
+  });
+  read_list(root, "paint_repainted", w.paint_changes, [&](YamlMap& m) {
+    PaintChange c;
+    stretch(m, c.where, c.road, c.at, c.length);
+    c.shift = y.number_in(m.required("shift"), "shift", -5.0, 5.0);
+    return c;
+  });
+  read_list(root, "construction", w.construction, [&](YamlMap& m) {
+    ConstructionZone z;
+    stretch(m, z.where, z.road, z.at, z.length);
+    if (const YAML::Node side = m["side"]) z.side = read_side(y, side);
+    if (z.side == RoadSide::both) y.fail(m["side"], "a construction zone closes one side: left or right");
+    return z;
+  });
+  root.done();
+  return w;
 }
 
 WorldDescription on_ideal_ground(WorldDescription d) {

@@ -8,6 +8,7 @@
 
 #include "common/curb_map_file.hpp"
 #include "common/geodetic.hpp"
+#include "common/yaml_reader.hpp"
 
 namespace lidarloop {
 
@@ -110,6 +111,20 @@ struct ParkedVehicleSpec {
   double yaw = 0;
 };
 
+// How today's world differs from the one the map was surveyed in (a scenario's `world_changes`): a
+// stretch of a road whose lane paint has worn away (shift 0) or been repainted `shift` metres to the
+// left of where it was, and a construction zone closing one side's lanes with cones and barriers.
+struct PaintChange {
+  std::string where, road;
+  double at = 0, length = 20;  // centre (arc length along the centreline) and extent along the road, m
+  double shift = 0;
+};
+struct ConstructionZone {
+  std::string where, road;
+  double at = 0, length = 30;
+  RoadSide side = RoadSide::right;
+};
+
 struct WorldGeometryParams {
   double corner_radius = 8.0;    // curb corner radius where roads meet
   double curb_top_width = 0.15;  // width of the curb stone's top face
@@ -150,11 +165,18 @@ struct WorldDescription {
   std::vector<PoleRow> poles;
   std::vector<TreeRow> trees;
   std::vector<ParkedVehicleSpec> parked;
+  std::vector<PaintChange> paint_changes;  // a world file has none: see apply_world_changes
+  std::vector<ConstructionZone> construction;
 
   const RoadSpec* road(const std::string& name) const;
 };
 
 WorldDescription load_world_description(const std::string& path);
+// Today's world: `surveyed` (the world file, as the map was surveyed) changed by a scenario's
+// `world_changes` mapping: parked vehicles gone (their positions) or new, lane paint worn or
+// repainted, construction zones. Errors name the scenario's file:line:col.
+WorldDescription apply_world_changes(WorldDescription surveyed, const YamlReader& y, const YAML::Node& changes);
+
 // The same world on ideal ground, as this project built every world before its roads had realism:
 // level smooth carriageways and sidewalks, no hills, uniform vertical curbs without gutters or cuts.
 // For tests that need known, clean geometry; scenarios never use it.

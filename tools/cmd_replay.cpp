@@ -59,7 +59,7 @@ int run_replay(const Args& args) {
   std::optional<std::string> method = args.value("method");
   if (!method && !recorded_method.empty()) method = recorded_method;
   const LocalizerParams params = localizer_params_for(scenario, method);
-  const LoadedWorld world = load_world(scenario.world);
+  const LoadedWorld world = load_scenario_world(scenario);
   const ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
   HdMap map = open_scenario_map(scenario, world);
 

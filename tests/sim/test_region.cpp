@@ -245,6 +245,14 @@ TEST(RegionClipLines, LineOutsideIsKeptWhole) {
   EXPECT_NEAR(polyline_length(out[0]), std::sqrt(200.0) + 30, 1e-3);
 }
 
+TEST(RegionClipLines, NoRegionKeepsEveryLine) {
+  // Clipper alone returns nothing here (a road with no junction and no crosswalk had no paint).
+  const std::vector<Polyline2d> out = region::clip_lines_outside({{{0, 0}, {40, 0}}, {{0, 3}, {10, 3}}}, {});
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NEAR(polyline_length(out[0]), 40, 1e-3);
+  EXPECT_NEAR(polyline_length(out[1]), 10, 1e-3);
+}
+
 TEST(RegionContains, HoleIsOutside) {
   const region::Paths frame =
       region::subtract(region::rectangle({0, 0}, {1, 0}, 10, 10), region::rectangle({0, 0}, {1, 0}, 5, 5));
