@@ -47,7 +47,7 @@ Command world_command() {
            "Build a world (a name under maps/ or a world.yaml path); print its size, export mesh and curbs.",
            {{"obj", "FILE", "write the triangle mesh as Wavefront OBJ (one usemtl group per material)"},
             {"curbs", "FILE", "write the curb map as GeoJSON LineStrings in WGS-84"},
-            {"png", "FILE", "write a top view coloured by material, curbs in green"},
+            {"png", "FILE", "write a top view coloured by material, curb lines by kind (with a key)"},
             {"resolution", "M", "metres per pixel of the top view (default 0.25)"}},
            1,
            1},
