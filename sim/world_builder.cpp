@@ -29,19 +29,28 @@ constexpr float kBandLow = 0.40f, kBandHigh = 0.55f, kBandRadiusLow = 0.105f, kB
 constexpr double kBarrierLength = 3.8, kBarrierJoint = 0.05;         // m; a barrier segment and half the gap between
 constexpr float kBarrierHeight = 0.81f, kBarrierHalfWidth = 0.305f;  // m
 
+// Roadside: hedges are meshed in pieces this long; a hydrant's barrel is this share of its height,
+// its cap narrows to this share of its radius; a verge starts just behind the curb's top and lies a
+// little above the raised ground, so the two do not fight for the same rays.
+constexpr double kHedgePiece = 1.0;                           // m
+constexpr float kHydrantBody = 0.8f, kHydrantCapTop = 0.5f;   // -
+constexpr double kVergeFromCurbTop = 0.3, kVergeLift = 0.01;  // m
+constexpr double kFurnitureClearance = 0.2;                   // m from the carriageway to a post's axis
+
 Eigen::Vector2d left_normal(const Eigen::Vector2d& tangent) { return {-tangent.y(), tangent.x()}; }
 
-// A quad of paint draped over the pavement `height` above it: split along its length into pieces,
-// each corner at the pavement's height there.
+// A quad of paint (or grass) draped `height` above the ground: split along its length into pieces,
+// each corner at the ground's height there.
+template <class Ground>
 void add_paint_quad(TriangleMesh& mesh, const Eigen::Vector2d& centre, const Eigen::Vector2d& along, double half_length,
-                    double half_width, const RoadSurface& surface, double height, MaterialId m) {
+                    double half_width, const Ground& ground, double height, MaterialId m) {
   const Eigen::Vector2d u = along.normalized(), v(-u.y(), u.x());
   const int pieces = std::max(1, int(std::ceil(2 * half_length / kPaintPiece)));
   const auto base = static_cast<uint32_t>(mesh.vertices.size());
   for (int k = 0; k <= pieces; ++k)
     for (double side : {-1.0, 1.0}) {
       const Eigen::Vector2d p = centre + u * (half_length * (2.0 * k / pieces - 1)) + v * (side * half_width);
-      mesh.vertices.emplace_back(float(p.x()), float(p.y()), float(surface.carriageway(p) + height));
+      mesh.vertices.emplace_back(float(p.x()), float(p.y()), float(ground(p) + height));
     }
   for (uint32_t k = 0; k < uint32_t(pieces); ++k) {  // vertices 2k (right), 2k + 1 (left)
     mesh.add_triangle(base + 2 * k, base + 2 * k + 2, base + 2 * k + 3, m);
@@ -50,12 +59,13 @@ void add_paint_quad(TriangleMesh& mesh, const Eigen::Vector2d& centre, const Eig
 }
 
 // A strip of paint along a polyline.
-void add_paint_line(TriangleMesh& mesh, const Polyline2d& line, double half_width, const RoadSurface& surface,
-                    double height, MaterialId m) {
+template <class Ground>
+void add_paint_line(TriangleMesh& mesh, const Polyline2d& line, double half_width, const Ground& ground, double height,
+                    MaterialId m) {
   for (size_t i = 1; i < line.size(); ++i) {
     const Eigen::Vector2d d = line[i] - line[i - 1];
     if (d.norm() < 1e-4) continue;
-    add_paint_quad(mesh, 0.5 * (line[i] + line[i - 1]), d, 0.5 * d.norm(), half_width, surface, height, m);
+    add_paint_quad(mesh, 0.5 * (line[i] + line[i - 1]), d, 0.5 * d.norm(), half_width, ground, height, m);
   }
 }
 
@@ -170,6 +180,7 @@ struct Builder {
   void build_markings() {
     const auto& g = desc.geometry;
     const RoadSurface& surface = *world.surface;
+    const auto pavement = [&](const Eigen::Vector2d& p) { return surface.carriageway(p); };
     const double z = g.paint_height;
     const MaterialId lane = mat("lane_paint"), zebra = mat("crosswalk_paint");
     for (const auto& c : desc.crosswalks) {
@@ -183,7 +194,7 @@ struct Builder {
       for (int k = 0; k < stripes; ++k) {
         const double lateral = (k - (stripes - 1) / 2.0) * period;
         const Eigen::Vector2d centre = s.point + n * lateral;
-        add_paint_quad(world.mesh, centre, s.tangent, c.width / 2, g.crosswalk_stripe / 2, surface, z, zebra);
+        add_paint_quad(world.mesh, centre, s.tangent, c.width / 2, g.crosswalk_stripe / 2, pavement, z, zebra);
       }
     }
     for (const auto& sl : desc.stop_lines) {
@@ -193,7 +204,7 @@ struct Builder {
       const double inset = g.edge_line_inset + road.gutter_width;
       const double lo = sl.side == RoadSide::left ? 0.0 : -road.width / 2 + inset;
       const double hi = sl.side == RoadSide::right ? 0.0 : road.width / 2 - inset;
-      add_paint_line(world.mesh, {s.point + n * lo, s.point + n * hi}, g.stop_line_width / 2, surface, z, lane);
+      add_paint_line(world.mesh, {s.point + n * lo, s.point + n * hi}, g.stop_line_width / 2, pavement, z, lane);
     }
     // Where the paint changed since the survey (a scenario's world_changes): today's lines there are
     // gone, or redrawn `shift` to the left.
@@ -223,7 +234,7 @@ struct Builder {
               for (const auto& dash : dashes(line, g.dash_length, g.dash_gap)) pieces.push_back(dash);
           }
           if (!worn.empty()) pieces = region::clip_lines_outside(pieces, worn);
-          for (const auto& piece : pieces) add_paint_line(world.mesh, piece, g.paint_width / 2, surface, z, lane);
+          for (const auto& piece : pieces) add_paint_line(world.mesh, piece, g.paint_width / 2, pavement, z, lane);
         }
       };
       paint(road.centreline, road.closed, 0, changed);
@@ -246,7 +257,10 @@ struct Builder {
     }
     const MaterialId metal = mat("metal"), sign = mat("retro_reflector"), leaves = mat("vegetation");
     const region::Paths near_carriageway = region::offset(world.carriageway, 0.5);
-    auto row_positions = [&](const RowSpec& row, std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>& out) {
+    // Street furniture stands closer to the curb than poles and trees: clear of the road by this.
+    const region::Paths near_for_furniture = region::offset(world.carriageway, kFurnitureClearance);
+    auto row_positions = [&](const RowSpec& row, std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>& out,
+                             const region::Paths& keep_out) {
       const RoadSpec& road = *desc.road(row.road);
       const double len = polyline_length(road.centreline);
       for (double s = row.start; s <= len; s += row.spacing) {
@@ -255,14 +269,14 @@ struct Builder {
           if ((side > 0 && row.side == RoadSide::right) || (side < 0 && row.side == RoadSide::left)) continue;
           const Eigen::Vector2d p = at.point + left_normal(at.tangent) * side * (road.width / 2 + row.setback);
           // Rows run through intersections; skip the positions that fall on a carriageway.
-          if (region::contains(near_carriageway, p)) continue;
+          if (region::contains(keep_out, p)) continue;
           out.emplace_back(p, at.tangent);
         }
       }
     };
     for (const auto& row : desc.poles) {
       std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots;
-      row_positions(row, spots);
+      row_positions(row, spots, near_carriageway);
       for (const auto& [p, t] : spots) {
         const float base = world.raised_level(p);
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base}, 0.08f, 0.06f, float(row.height), 12, metal);
@@ -273,13 +287,68 @@ struct Builder {
     }
     for (const auto& row : desc.trees) {
       std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots;
-      row_positions(row, spots);
+      row_positions(row, spots, near_carriageway);
       for (const auto& [p, t] : spots) {
         const float base = world.raised_level(p), h = float(row.height), r = float(row.crown_radius);
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base}, 0.15f, 0.12f, 0.45f * h, 8, leaves);
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base + 0.35f * h}, 0.3f, r, 0.3f * h, 10, leaves);
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base + 0.65f * h}, r, 0.3f, 0.35f * h, 10, leaves);
       }
+    }
+    // Street furniture by the curb: bollards (steel) and hydrants (painted iron, a cap on top).
+    const MaterialId painted = mat("vehicle_paint");
+    for (const auto& row : desc.bollards) {
+      std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots;
+      row_positions(row, spots, near_for_furniture);
+      for (const auto& [p, t] : spots)
+        add_frustum(world.mesh, {float(p.x()), float(p.y()), world.raised_level(p)}, float(row.diameter / 2),
+                    float(row.diameter / 2), float(row.height), 10, metal);
+    }
+    for (const auto& row : desc.hydrants) {
+      std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots;
+      row_positions(row, spots, near_for_furniture);
+      for (const auto& [p, t] : spots) {
+        const float base = world.raised_level(p), r = float(row.diameter / 2), body = float(row.height) * kHydrantBody;
+        add_frustum(world.mesh, {float(p.x()), float(p.y()), base}, r, r, body, 10, painted);
+        add_frustum(world.mesh, {float(p.x()), float(p.y()), base + body}, r, r * kHydrantCapTop,
+                    float(row.height) - body, 10, painted);
+      }
+    }
+    // Hedges: a bank of leaves behind the curb, leaning out over the curb line above its clearance.
+    for (const auto& h : desc.hedges) {
+      const RoadSpec& road = *desc.road(h.road);
+      const Polyline2d stretch = stretch_of(road.centreline, h.at, h.length);
+      const double length = polyline_length(stretch);
+      for (double side : {1.0, -1.0}) {
+        if ((side > 0 && h.side == RoadSide::right) || (side < 0 && h.side == RoadSide::left)) continue;
+        for (double s = kHedgePiece / 2; s < length; s += kHedgePiece) {
+          const PolylineSample at = sample_polyline(stretch, s);
+          const Eigen::Vector2d out = left_normal(at.tangent) * side;
+          const float yaw = float(std::atan2(at.tangent.y(), at.tangent.x()));
+          const Eigen::Vector2d trunk = at.point + out * (road.width / 2 + h.setback + h.depth / 2);
+          if (region::contains(near_carriageway, trunk)) continue;  // a junction crosses the stretch
+          const float base = world.raised_level(trunk);
+          add_box(world.mesh, trunk.cast<float>(), {float(kHedgePiece / 2), float(h.depth / 2)}, yaw, base,
+                  base + float(h.height), leaves);
+          // The overhang: from the curb line minus `overhang` to the hedge's face.
+          const double inner = road.width / 2 - h.overhang, outer = road.width / 2 + h.setback;
+          const Eigen::Vector2d lean = at.point + out * ((inner + outer) / 2);
+          add_box(world.mesh, lean.cast<float>(), {float(kHedgePiece / 2), float((outer - inner) / 2)}, yaw,
+                  base + float(h.clearance), base + float(h.height), leaves);
+        }
+      }
+    }
+    // Grass verges: a strip of grass between the curb and the sidewalk, draped over the raised ground.
+    const MaterialId grass = mat("grass");
+    const auto raised = [&](const Eigen::Vector2d& p) { return double(world.raised_level(p)); };
+    for (const auto& road : desc.roads) {
+      if (road.verge_width <= 0) continue;
+      const double inner = road.width / 2 + desc.geometry.curb_top_width + kVergeFromCurbTop;
+      for (double side : {1.0, -1.0})
+        for (const auto& line : region::clip_lines_outside(
+                 {offset_polyline(road.centreline, side * (inner + road.verge_width / 2), road.closed)},
+                 near_carriageway))
+          add_paint_line(world.mesh, line, road.verge_width / 2, raised, kVergeLift, grass);
     }
     // Construction zones (a scenario's world_changes): cones along the closed side's inner edge, with
     // a retro-reflective band, and concrete barriers down the middle of the closed lanes.

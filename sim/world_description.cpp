@@ -63,7 +63,8 @@ void read_road_properties(YamlMap& m, RoadSpec& road) {
       .number("gutter_width", road.gutter_width, 0.0, 1.8)
       .number("gutter_slope", road.gutter_slope, 0.0, 0.12)
       .number("driveway_spacing", road.driveway_spacing, 0.0, 1000.0)
-      .number("driveway_width", road.driveway_width, 2.0, 15.0);
+      .number("driveway_width", road.driveway_width, 2.0, 15.0)
+      .number("verge_width", road.verge_width, 0.0, 10.0);
   if (const YAML::Node marking = m["marking"]) road.marking = read_marking(y, marking);
   if (const YAML::Node profile = m["curb_profile"]) road.curb_profile = read_curb_profile(y, profile);
   if (road.curb_height_variation >= road.curb_height)
@@ -157,6 +158,9 @@ void check_references(const YamlReader& y, const YAML::Node& root, WorldDescript
   for (size_t i = 0; i < w.curb_cuts.size(); ++i) check("curb_cuts", i, w.curb_cuts[i].road, w.curb_cuts[i].at, true);
   for (size_t i = 0; i < w.poles.size(); ++i) check("poles", i, w.poles[i].road, 0, false);
   for (size_t i = 0; i < w.trees.size(); ++i) check("trees", i, w.trees[i].road, 0, false);
+  for (size_t i = 0; i < w.bollards.size(); ++i) check("bollards", i, w.bollards[i].road, 0, false);
+  for (size_t i = 0; i < w.hydrants.size(); ++i) check("hydrants", i, w.hydrants[i].road, 0, false);
+  for (size_t i = 0; i < w.hedges.size(); ++i) check("hedges", i, w.hedges[i].road, w.hedges[i].at, true);
 }
 
 ParkedVehicleSpec read_parked(YamlMap& m) {
@@ -171,6 +175,23 @@ ParkedVehicleSpec read_parked(YamlMap& m) {
   p.position = y.vec2(m.required("position"), "position");
   m.degrees("yaw_deg", p.yaw, -360.0, 360.0);
   return p;
+}
+
+HedgeSpec read_hedge(YamlMap& m, const WorldDescription& w) {
+  const YamlReader& y = m.reader();
+  HedgeSpec h;
+  h.where = m.where();
+  h.road = y.string(m.required("road"), "road");
+  h.at = read_station(m, w, h.road);
+  if (const YAML::Node side = m["side"]) h.side = read_side(y, side);
+  m.number("length", h.length, 1.0, 5000.0)
+      .number("setback", h.setback, 0.0, 20.0)
+      .number("depth", h.depth, 0.2, 5.0)
+      .number("height", h.height, 0.3, 5.0)
+      .number("overhang", h.overhang, 0.0, 2.0)
+      .number("clearance", h.clearance, 0.0, 3.0);
+  if (h.clearance >= h.height) y.fail(m.node(), "a hedge's clearance must be below its height");
+  return h;
 }
 
 WorldDescription parse(const YamlReader& y) {
@@ -284,6 +305,22 @@ WorldDescription parse(const YamlReader& y) {
     m.number("height", t.height, 2.0, 40.0).number("crown_radius", t.crown_radius, 0.5, 10.0);
     return t;
   });
+  read_list(root, "bollards", w.bollards, [&](YamlMap& m) {
+    BollardRow b;
+    b.setback = 0.45;
+    read_row(m, b);
+    m.number("height", b.height, 0.3, 2.0).number("diameter", b.diameter, 0.05, 0.6);
+    return b;
+  });
+  read_list(root, "hydrants", w.hydrants, [&](YamlMap& m) {
+    HydrantRow h;
+    h.setback = 0.6;
+    h.spacing = 120;
+    read_row(m, h);
+    m.number("height", h.height, 0.3, 1.5).number("diameter", h.diameter, 0.1, 0.6);
+    return h;
+  });
+  read_list(root, "hedges", w.hedges, [&](YamlMap& m) { return read_hedge(m, w); });
   read_list(root, "parked_vehicles", w.parked, [&](YamlMap& m) { return read_parked(m); });
   root.done();
   check_references(y, y.root(), w);
@@ -321,6 +358,13 @@ WorldDescription apply_world_changes(WorldDescription w, const YamlReader& y, co
     if (!r) y.fail(m.node()["road"], "unknown road '" + road + "'");
     if (at > polyline_length(r->centreline)) y.fail(m.node(), "beyond the end of road '" + road + "'");
   };
+  // Seasonal vegetation: hedges grown (or planted) since the survey.
+  read_list(root, "vegetation_grown", w.hedges, [&](YamlMap& m) {
+    HedgeSpec h = read_hedge(m, w);
+    const RoadSpec* r = w.road(h.road);
+    if (!r) y.fail(m.node()["road"], "unknown road '" + h.road + "'");
+    return h;
+  });
   read_list(root, "paint_worn", w.paint_changes, [&](YamlMap& m) {
     PaintChange c;
     stretch(m, c.where, c.road, c.at, c.length);

@@ -49,6 +49,7 @@ struct RoadSpec {
   double gutter_slope = 0.06;
   double driveway_spacing = 0;  // m between driveway cuts along each side; 0 = none
   double driveway_width = 4.0;  // m, at the curb line
+  double verge_width = 0;       // m of grass between the curb and the sidewalk; 0 = none
   // km/h: sets the superelevation of its curves (sim/superelevation.hpp); a campus street's 30 km/h
   // asks for none on a 40 m radius.
   double design_speed = 30;
@@ -103,6 +104,24 @@ struct PoleRow : RowSpec {
 struct TreeRow : RowSpec {
   double height = 6.0, crown_radius = 2.0;
 };
+// Street furniture close to the curb. Bollards: steel posts, commonly 0.9-1.1 m tall and 0.15-0.2 m
+// across (manufacturers' catalogues; an assumption, no standard fixes them). Hydrants: 0.6-0.9 m tall,
+// set about 0.6 m (2 ft) behind the curb face (common municipal practice; an assumption).
+struct BollardRow : RowSpec {
+  double height = 1.0, diameter = 0.2;
+};
+struct HydrantRow : RowSpec {
+  double height = 0.75, diameter = 0.25;
+};
+// A hedge or a row of shrubs along a stretch of one side of a road: `setback` behind the curb line to
+// its trunks, `depth` deep; above `clearance` its foliage leans out over the curb line by `overhang`, so
+// a LiDAR looking down the road sees leaves where the curb is.
+struct HedgeSpec {
+  std::string where, road;
+  RoadSide side = RoadSide::right;
+  double at = 0, length = 20;
+  double setback = 0.5, depth = 0.8, height = 1.2, overhang = 0.3, clearance = 0.4;
+};
 
 struct ParkedVehicleSpec {
   std::string where;
@@ -147,9 +166,9 @@ struct WorldGeometryParams {
   char roughness_class = 'B';                                              // or '-' for a perfectly smooth pavement
   double roughness_min_wavelength = 0.5, roughness_max_wavelength = 10.0;  // m
   uint64_t roughness_seed = 1;
-  bool crosswalk_ramps = true;
+  bool crosswalk_ramps = true;  // every crosswalk gets a curb ramp on both sides (ADA 406)
   // Curves are banked at most this much: AASHTO 2011 3.3.3, 4 % for urban streets (ice, slow traffic).
-  double max_superelevation = 0.04;  // every crosswalk gets a curb ramp on both sides (ADA 406)
+  double max_superelevation = 0.04;
 };
 
 struct WorldDescription {
@@ -164,6 +183,9 @@ struct WorldDescription {
   std::vector<BuildingSpec> buildings;
   std::vector<PoleRow> poles;
   std::vector<TreeRow> trees;
+  std::vector<BollardRow> bollards;
+  std::vector<HydrantRow> hydrants;
+  std::vector<HedgeSpec> hedges;
   std::vector<ParkedVehicleSpec> parked;
   std::vector<PaintChange> paint_changes;  // a world file has none: see apply_world_changes
   std::vector<ConstructionZone> construction;

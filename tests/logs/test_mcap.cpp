@@ -1,6 +1,8 @@
 // MCAP logs: the writer's format (chunks, indexes, summary, CRCs), exact round trips of every
 // stream, byte-identical output, chunk closing by size and time, recovery of cut and corrupted
 // files, and malformed input giving InputError rather than a crash.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,8 +29,10 @@ namespace {
 namespace topics = log_topics;
 using Bytes = std::vector<uint8_t>;
 
+// Per process: CTest runs each test case in its own process, two at a time, and every process of this
+// suite writes the synthetic log first; a shared folder let one truncate the file another was reading.
 std::string temp_path(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "lidarloop_test_mcap";
+  const auto dir = std::filesystem::temp_directory_path() / ("lidarloop_test_mcap_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }

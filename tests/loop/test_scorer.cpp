@@ -6,6 +6,8 @@
 #include <numbers>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -62,7 +64,8 @@ std::vector<EstimateRecord> offset_estimates(double seconds, double lon, double 
 }
 
 std::string temp_path(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "lidarloop_test_scorer";
+  // Per process: CTest runs test cases as parallel processes.
+  const auto dir = std::filesystem::temp_directory_path() / ("lidarloop_test_scorer_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }

@@ -85,6 +85,16 @@ TEST(WorldChanges, AConstructionZoneStandsConesAndBarriersOnTheClosedSide) {
   EXPECT_LT(look_down(w, 8.0, 2.0).range, 0.05);  // the open lane is clear
 }
 
+TEST(WorldChanges, AHedgeGrownSinceTheSurveyLeansOverTheCurbToday) {
+  const World then = build(surveyed());
+  const World now =
+      build(today("  vegetation_grown: [{road: main, at: 30, length: 10, side: right, overhang: 0.3}]\n"));
+  const MaterialId leaves = test::materials().id("vegetation", "test");
+  EXPECT_NE(look_down(then, 30, -4.0).material, leaves);
+  EXPECT_EQ(look_down(now, 30, -4.0).material, leaves);  // over the right curb line
+  EXPECT_NE(look_down(now, 20, -4.0).material, leaves);  // outside the stretch
+}
+
 TEST(WorldChanges, MistakesAreErrorsAtTheirLine) {
   auto message = [](const std::string& changes) {
     try {
