@@ -1,8 +1,10 @@
 #include "sim/world_builder.hpp"
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <memory>
+#include <unordered_map>
 
 #include "common/input_error.hpp"
 #include "sim/actor_assets.hpp"
@@ -29,15 +31,117 @@ constexpr float kBandLow = 0.40f, kBandHigh = 0.55f, kBandRadiusLow = 0.105f, kB
 constexpr double kBarrierLength = 3.8, kBarrierJoint = 0.05;         // m; a barrier segment and half the gap between
 constexpr float kBarrierHeight = 0.81f, kBarrierHalfWidth = 0.305f;  // m
 
-// Roadside: hedges are meshed in pieces this long; a hydrant's barrel is this share of its height,
-// its cap narrows to this share of its radius; a verge starts just behind the curb's top and lies a
-// little above the raised ground, so the two do not fight for the same rays.
-constexpr double kHedgePiece = 1.0;                           // m
-constexpr float kHydrantBody = 0.8f, kHydrantCapTop = 0.5f;   // -
-constexpr double kVergeFromCurbTop = 0.3, kVergeLift = 0.01;  // m
-constexpr double kFurnitureClearance = 0.2;                   // m from the carriageway to a post's axis
+// Roadside: a hydrant's barrel is this share of its height, its cap narrows to this share of its
+// radius; a verge lies a little above the raised ground, so the two do not fight for the same rays; a
+// hedge's foot is sunk a little into the ground, so no ray passes under it on a slope.
+constexpr float kHydrantBody = 0.8f, kHydrantCapTop = 0.5f;  // -
+constexpr double kVergeLift = 0.01, kHedgeSink = 0.05;       // m
+constexpr double kFurnitureClearance = 0.2;                  // m from the carriageway to a post's axis
+// A curb cross-section this close to a road's half width from its centreline, and facing within this
+// much of square to it, runs along that road (otherwise it turns round a junction's corner): hedges
+// and verges follow only those.
+constexpr double kAlongRoad = 0.3;        // m
+constexpr double kAlongRoadFacing = 0.1;  // |sin| of the angle off square
+constexpr double kLoweredCell = 2.0;      // m; grid of lowered curb points for look-ups within this
 
 Eigen::Vector2d left_normal(const Eigen::Vector2d& tangent) { return {-tangent.y(), tangent.x()}; }
+
+// Where the curb is lowered: cut for a driveway, a ramp or a bus bay, or tapering down beside one over
+// its flares. Roadside objects keep clear of these stretches (they are kept open for vehicles and
+// pedestrians), looked up on a coarse grid.
+bool lowered(const CurbStation& c) { return c.cut || c.height < c.nominal_height - 1e-6; }
+
+class LoweredCurb {
+ public:
+  explicit LoweredCurb(const RaisedGround& band) {
+    for (const auto& ring : band.rings())
+      for (const CurbStation& c : ring)
+        if (lowered(c)) cells_[key(cell(c.point, 0), cell(c.point, 1))].push_back(c.point);
+  }
+  // Whether a lowered curb point lies within `radius` (at most kLoweredCell) of p.
+  bool near(const Eigen::Vector2d& p, double radius) const {
+    const int64_t i = cell(p, 0), j = cell(p, 1);
+    for (int64_t di = -1; di <= 1; ++di)
+      for (int64_t dj = -1; dj <= 1; ++dj) {
+        const auto it = cells_.find(key(i + di, j + dj));
+        if (it == cells_.end()) continue;
+        for (const auto& q : it->second)
+          if ((q - p).squaredNorm() <= radius * radius) return true;
+      }
+    return false;
+  }
+
+ private:
+  static int64_t cell(const Eigen::Vector2d& p, int axis) { return int64_t(std::floor(p[axis] / kLoweredCell)); }
+  static int64_t key(int64_t i, int64_t j) { return i * 4000037 + j; }
+  std::unordered_map<int64_t, std::vector<Eigen::Vector2d>> cells_;
+};
+
+// Runs of consecutive true flags round a ring of n: [first, first + count) modulo n; a ring whose flags
+// are all true is one run of n, `closed`.
+struct Run {
+  size_t first = 0, count = 0;
+  bool closed = false;
+};
+std::vector<Run> runs_of(const std::vector<char>& on) {
+  const size_t n = on.size();
+  size_t start = 0;
+  while (start < n && on[start]) ++start;
+  if (start == n) return n ? std::vector<Run>{{0, n, true}} : std::vector<Run>{};
+  std::vector<Run> out;
+  for (size_t k = 1; k <= n; ++k) {
+    const size_t i = (start + k) % n;
+    if (!on[i]) continue;
+    if (on[(i + n - 1) % n] && !out.empty() && k > 1)
+      ++out.back().count;
+    else
+      out.push_back({i, 1, false});
+  }
+  return out;
+}
+
+// A hedge's cross-section, in metres behind the curb line (negative: over the road) and above the
+// ground at its trunks: a bank of `depth` from `setback` back, full height; above `clearance` its
+// road-facing side leans out from the curb line to `overhang` in front of it at the top.
+std::array<Eigen::Vector2d, 6> hedge_section(const HedgeSpec& h) {
+  const double back = h.setback + h.depth;
+  return {{{back, 0},
+           {back, h.height},
+           {-h.overhang, h.height},
+           {0, h.clearance},
+           {h.setback, h.clearance},
+           {h.setback, 0}}};
+}
+
+// A hedge along a run of curb cross-sections: its section swept from one to the next (a cap at each
+// end of an open run). Points at height 0 are sunk a little into the ground under them.
+void add_hedge(TriangleMesh& mesh, const std::vector<const CurbStation*>& run, bool closed, const HedgeSpec& h,
+               const std::function<float(const Eigen::Vector2d&)>& ground, MaterialId m) {
+  const auto section = hedge_section(h);
+  constexpr uint32_t kN = 6;
+  const auto base = static_cast<uint32_t>(mesh.vertices.size());
+  for (const CurbStation* c : run) {
+    const Eigen::Vector2d out = c->normal * c->miter;
+    const double level = ground(c->point + out * (h.setback + h.depth / 2));
+    for (const Eigen::Vector2d& q : section) {
+      const Eigen::Vector2d xy = c->point + out * q.x();
+      const double z = q.y() > 0 ? level + q.y() : ground(xy) - kHedgeSink;
+      mesh.vertices.emplace_back(float(xy.x()), float(xy.y()), float(z));
+    }
+  }
+  const auto n = uint32_t(run.size());
+  for (uint32_t i = 0; i + (closed ? 0 : 1) < n; ++i) {
+    const uint32_t a = base + i * kN, b = base + ((i + 1) % n) * kN;
+    for (uint32_t k = 0; k < kN; ++k) {
+      const uint32_t k1 = (k + 1) % kN;
+      mesh.add_triangle(a + k, a + k1, b + k1, m);
+      mesh.add_triangle(a + k, b + k1, b + k, m);
+    }
+  }
+  if (closed) return;
+  for (const uint32_t end : {base, base + (n - 1) * kN})  // a fan from the back top corner
+    for (uint32_t k = 2; k + 1 <= kN; ++k) mesh.add_triangle(end + 1, end + k, end + (k + 1) % kN, m);
+}
 
 // A quad of paint (or grass) draped `height` above the ground: split along its length into pieces,
 // each corner at the ground's height there.
@@ -243,6 +347,80 @@ struct Builder {
     }
   }
 
+  // Whether a curb cross-section runs along `road` (not round a junction's corner) at full height (not
+  // cut or on a flare), and on which side: +1 left of its centreline, -1 right, 0 neither.
+  int along_full_curb(const CurbStation& c, const RoadSpec& road) const {
+    if (c.road < 0 || &desc.roads[size_t(c.road)] != &road || lowered(c)) return 0;
+    const RoadPoint at = world.surface->nearest_road(c.point);
+    if (std::abs(at.distance - road.width / 2) >= kAlongRoad || std::abs(c.normal.dot(at.tangent)) >= kAlongRoadFacing)
+      return 0;
+    return at.lateral > 0 ? 1 : -1;
+  }
+
+  // Hedges follow the curb line's cross-sections, so they bend with it, along the stretch and side of
+  // their road where its curb is at full height: they leave cuts and their flares open and stop at a
+  // junction's corner.
+  void build_hedges(MaterialId leaves) {
+    for (const auto& h : desc.hedges) {
+      const RoadSpec& road = *desc.road(h.road);
+      const double length = polyline_length(road.centreline);
+      for (const auto& ring : world.curb_band->rings()) {
+        std::vector<char> on(ring.size(), 0);
+        for (size_t i = 0; i < ring.size(); ++i) {
+          const CurbStation& c = ring[i];
+          double from_centre = c.s - h.at;
+          if (road.closed) from_centre = std::remainder(from_centre, length);
+          if (std::abs(from_centre) > h.length / 2) continue;
+          const int side = along_full_curb(c, road);
+          if (side == 0 || (side > 0 && h.side == RoadSide::right) || (side < 0 && h.side == RoadSide::left)) continue;
+          // A hedge set far back must not reach another road's carriageway.
+          const Eigen::Vector2d back = c.point + c.normal * (c.miter * (h.setback + h.depth));
+          on[i] = !region::contains(world.carriageway, back);
+        }
+        for (const Run& run : runs_of(on)) {
+          if (run.count < 2) continue;
+          std::vector<const CurbStation*> stations;
+          for (size_t k = 0; k < run.count; ++k) stations.push_back(&ring[(run.first + k) % ring.size()]);
+          add_hedge(world.mesh, stations, run.closed, h, world.raised_level, leaves);
+        }
+      }
+    }
+  }
+
+  // Grass verges: a strip `verge_width` wide right behind the curb band, laid over the raised ground
+  // along every full-height curb of the road (driveways, ramps and bus bays are paved through it).
+  void build_verges() {
+    const MaterialId grass = mat("grass");
+    const double inner = curb_band_widths(desc).outer;
+    for (const auto& ring : world.curb_band->rings()) {
+      const size_t n = ring.size();
+      std::vector<char> on(n, 0);
+      for (size_t i = 0; i < n; ++i) {
+        if (ring[i].road < 0) continue;
+        const RoadSpec& road = desc.roads[size_t(ring[i].road)];
+        on[i] = road.verge_width > 0 && along_full_curb(ring[i], road) != 0;
+      }
+      for (const Run& run : runs_of(on)) {
+        if (run.count < 2) continue;
+        const auto base = static_cast<uint32_t>(world.mesh.vertices.size());
+        for (size_t k = 0; k < run.count; ++k) {
+          const CurbStation& c = ring[(run.first + k) % n];
+          const double outer = inner + desc.roads[size_t(c.road)].verge_width;
+          for (const double o : {inner, outer}) {
+            const Eigen::Vector2d xy = c.point + c.normal * (c.miter * o);
+            world.mesh.vertices.emplace_back(float(xy.x()), float(xy.y()), world.raised_level(xy) + float(kVergeLift));
+          }
+        }
+        const auto count = uint32_t(run.count);
+        for (uint32_t k = 0; k + (run.closed ? 0 : 1) < count; ++k) {
+          const uint32_t a = base + 2 * k, b = base + 2 * ((k + 1) % count);
+          world.mesh.add_triangle(a, b, b + 1, grass);
+          world.mesh.add_triangle(a, b + 1, a + 1, grass);
+        }
+      }
+    }
+  }
+
   void build_objects() {
     for (const auto& b : desc.buildings) {
       const MaterialId m = materials.id(b.material, b.where);
@@ -259,8 +437,9 @@ struct Builder {
     const region::Paths near_carriageway = region::offset(world.carriageway, 0.5);
     // Street furniture stands closer to the curb than poles and trees: clear of the road by this.
     const region::Paths near_for_furniture = region::offset(world.carriageway, kFurnitureClearance);
+    // Where a row puts its objects (and, if asked, the foot of each on the curb line).
     auto row_positions = [&](const RowSpec& row, std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>& out,
-                             const region::Paths& keep_out) {
+                             const region::Paths& keep_out, std::vector<Eigen::Vector2d>* feet) {
       const RoadSpec& road = *desc.road(row.road);
       const double len = polyline_length(road.centreline);
       for (double s = row.start; s <= len; s += row.spacing) {
@@ -271,12 +450,13 @@ struct Builder {
           // Rows run through intersections; skip the positions that fall on a carriageway.
           if (region::contains(keep_out, p)) continue;
           out.emplace_back(p, at.tangent);
+          if (feet) feet->push_back(at.point + left_normal(at.tangent) * side * (road.width / 2));
         }
       }
     };
     for (const auto& row : desc.poles) {
       std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots;
-      row_positions(row, spots, near_carriageway);
+      row_positions(row, spots, near_carriageway, nullptr);
       for (const auto& [p, t] : spots) {
         const float base = world.raised_level(p);
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base}, 0.08f, 0.06f, float(row.height), 12, metal);
@@ -287,7 +467,7 @@ struct Builder {
     }
     for (const auto& row : desc.trees) {
       std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots;
-      row_positions(row, spots, near_carriageway);
+      row_positions(row, spots, near_carriageway, nullptr);
       for (const auto& [p, t] : spots) {
         const float base = world.raised_level(p), h = float(row.height), r = float(row.crown_radius);
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base}, 0.15f, 0.12f, 0.45f * h, 8, leaves);
@@ -295,61 +475,31 @@ struct Builder {
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base + 0.65f * h}, r, 0.3f, 0.35f * h, 10, leaves);
       }
     }
-    // Street furniture by the curb: bollards (steel) and hydrants (painted iron, a cap on top).
+    // Street furniture by the curb: bollards (steel) and hydrants (painted iron, a cap on top), not in
+    // front of a cut or on its flares (where the curb is lowered, within its radius along the curb).
     const MaterialId painted = mat("vehicle_paint");
-    for (const auto& row : desc.bollards) {
-      std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots;
-      row_positions(row, spots, near_for_furniture);
-      for (const auto& [p, t] : spots)
+    const LoweredCurb lowered_curb(*world.curb_band);
+    auto furniture_spots = [&](const RowSpec& row, double radius) {
+      std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots, kept;
+      std::vector<Eigen::Vector2d> feet;
+      row_positions(row, spots, near_for_furniture, &feet);
+      for (size_t k = 0; k < spots.size(); ++k)
+        if (!lowered_curb.near(feet[k], radius + kCurbStation)) kept.push_back(spots[k]);
+      return kept;
+    };
+    for (const auto& row : desc.bollards)
+      for (const auto& [p, t] : furniture_spots(row, row.diameter / 2))
         add_frustum(world.mesh, {float(p.x()), float(p.y()), world.raised_level(p)}, float(row.diameter / 2),
                     float(row.diameter / 2), float(row.height), 10, metal);
-    }
-    for (const auto& row : desc.hydrants) {
-      std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots;
-      row_positions(row, spots, near_for_furniture);
-      for (const auto& [p, t] : spots) {
+    for (const auto& row : desc.hydrants)
+      for (const auto& [p, t] : furniture_spots(row, row.diameter / 2)) {
         const float base = world.raised_level(p), r = float(row.diameter / 2), body = float(row.height) * kHydrantBody;
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base}, r, r, body, 10, painted);
         add_frustum(world.mesh, {float(p.x()), float(p.y()), base + body}, r, r * kHydrantCapTop,
                     float(row.height) - body, 10, painted);
       }
-    }
-    // Hedges: a bank of leaves behind the curb, leaning out over the curb line above its clearance.
-    for (const auto& h : desc.hedges) {
-      const RoadSpec& road = *desc.road(h.road);
-      const Polyline2d stretch = stretch_of(road.centreline, h.at, h.length);
-      const double length = polyline_length(stretch);
-      for (double side : {1.0, -1.0}) {
-        if ((side > 0 && h.side == RoadSide::right) || (side < 0 && h.side == RoadSide::left)) continue;
-        for (double s = kHedgePiece / 2; s < length; s += kHedgePiece) {
-          const PolylineSample at = sample_polyline(stretch, s);
-          const Eigen::Vector2d out = left_normal(at.tangent) * side;
-          const float yaw = float(std::atan2(at.tangent.y(), at.tangent.x()));
-          const Eigen::Vector2d trunk = at.point + out * (road.width / 2 + h.setback + h.depth / 2);
-          if (region::contains(near_carriageway, trunk)) continue;  // a junction crosses the stretch
-          const float base = world.raised_level(trunk);
-          add_box(world.mesh, trunk.cast<float>(), {float(kHedgePiece / 2), float(h.depth / 2)}, yaw, base,
-                  base + float(h.height), leaves);
-          // The overhang: from the curb line minus `overhang` to the hedge's face.
-          const double inner = road.width / 2 - h.overhang, outer = road.width / 2 + h.setback;
-          const Eigen::Vector2d lean = at.point + out * ((inner + outer) / 2);
-          add_box(world.mesh, lean.cast<float>(), {float(kHedgePiece / 2), float((outer - inner) / 2)}, yaw,
-                  base + float(h.clearance), base + float(h.height), leaves);
-        }
-      }
-    }
-    // Grass verges: a strip of grass between the curb and the sidewalk, draped over the raised ground.
-    const MaterialId grass = mat("grass");
-    const auto raised = [&](const Eigen::Vector2d& p) { return double(world.raised_level(p)); };
-    for (const auto& road : desc.roads) {
-      if (road.verge_width <= 0) continue;
-      const double inner = road.width / 2 + desc.geometry.curb_top_width + kVergeFromCurbTop;
-      for (double side : {1.0, -1.0})
-        for (const auto& line : region::clip_lines_outside(
-                 {offset_polyline(road.centreline, side * (inner + road.verge_width / 2), road.closed)},
-                 near_carriageway))
-          add_paint_line(world.mesh, line, road.verge_width / 2, raised, kVergeLift, grass);
-    }
+    build_hedges(leaves);
+    build_verges();
     // Construction zones (a scenario's world_changes): cones along the closed side's inner edge, with
     // a retro-reflective band, and concrete barriers down the middle of the closed lanes.
     const MaterialId cone = mat("traffic_cone"), concrete = mat("curb_concrete");

@@ -49,7 +49,7 @@ struct RoadSpec {
   double gutter_slope = 0.06;
   double driveway_spacing = 0;  // m between driveway cuts along each side; 0 = none
   double driveway_width = 4.0;  // m, at the curb line
-  double verge_width = 0;       // m of grass between the curb and the sidewalk; 0 = none
+  double verge_width = 0;       // m of grass right behind the curb's top (not across cuts); 0 = none
   // km/h: sets the superelevation of its curves (sim/superelevation.hpp); a campus street's 30 km/h
   // asks for none on a 40 m radius.
   double design_speed = 30;
@@ -106,7 +106,8 @@ struct TreeRow : RowSpec {
 };
 // Street furniture close to the curb. Bollards: steel posts, commonly 0.9-1.1 m tall and 0.15-0.2 m
 // across (manufacturers' catalogues; an assumption, no standard fixes them). Hydrants: 0.6-0.9 m tall,
-// set about 0.6 m (2 ft) behind the curb face (common municipal practice; an assumption).
+// set about 0.6 m (2 ft) behind the curb face (common municipal practice; an assumption). Neither
+// stands in front of a curb cut or on its flares: those places of a row stay empty.
 struct BollardRow : RowSpec {
   double height = 1.0, diameter = 0.2;
 };
@@ -114,8 +115,9 @@ struct HydrantRow : RowSpec {
   double height = 0.75, diameter = 0.25;
 };
 // A hedge or a row of shrubs along a stretch of one side of a road: `setback` behind the curb line to
-// its trunks, `depth` deep; above `clearance` its foliage leans out over the curb line by `overhang`, so
-// a LiDAR looking down the road sees leaves where the curb is.
+// its trunks, `depth` deep; above `clearance` its road-facing side leans out from the curb line to
+// `overhang` in front of it at the top, so a LiDAR looking down the road sees leaves where the curb
+// is. It follows the curb, leaves curb cuts and their flares open and stops at junctions' corners.
 struct HedgeSpec {
   std::string where, road;
   RoadSide side = RoadSide::right;

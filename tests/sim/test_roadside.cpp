@@ -55,6 +55,44 @@ TEST(Roadside, AHedgeLeansOverTheCurbLineAboveItsClearance) {
   const RayHit face = cast(scene, {30, -2, 0.08f}, {0, -1, 0});
   EXPECT_EQ(test::materials()[face.material].name, "curb_concrete");
   EXPECT_NEAR(face.range, 2.0, 0.02);
+  // The road-facing side leans out from the curb line at the clearance (0.4 m, the default) to 0.3 m
+  // in front of it at the top: halfway up, 0.8 m above the sidewalk, it is 0.15 m over the road.
+  const RayHit lean = cast(scene, {30, -2, 0.15f + 0.8f}, {0, -1, 0});
+  EXPECT_EQ(test::materials()[lean.material].name, "vegetation");
+  EXPECT_NEAR(lean.range, 4.0 - 0.15 - 2.0, 0.02);
+}
+
+// The same road with a driveway on each side at 30 m (6 m wide, flares 1.5 m): the hedge leaves it
+// open, the hydrant planned in front of it is left out, and the verge is paved across it.
+const std::string kDrivewayWorld = R"(name: roadside_driveways
+origin: {lat: 31.28, lon: 121.21}
+road_defaults: {width: 8.0, curb_height: 0.15, cross_slope: 0, verge_width: 1.0}
+geometry: {roughness_class: none, sidewalk_cross_slope: 0, crosswalk_ramps: false}
+roads:
+  - {name: main, points: [[0, 0], [60, 0]]}
+curb_cuts:
+  - {road: main, at: 30, side: right, length: 6, kind: driveway}
+  - {road: main, at: 30, side: left, length: 6, kind: driveway}
+hedges:
+  - {road: main, at: 30, length: 40, side: right}
+hydrants:
+  - {road: main, side: right, start: 30, spacing: 20}
+)";
+
+TEST(Roadside, CutsStayOpen) {
+  const World w = test::world_from_yaml(kDrivewayWorld);
+  const RayScene scene(w.mesh);
+  // Hedge: over the curb line beside the driveway (and its flares, to 34.5 m), not across it.
+  EXPECT_NE(down(scene, 30, -4.0).second, "vegetation");
+  EXPECT_NE(down(scene, 34, -4.0).second, "vegetation");
+  EXPECT_EQ(down(scene, 36, -4.0).second, "vegetation");
+  EXPECT_EQ(down(scene, 24, -4.0).second, "vegetation");
+  // Hydrants: the one at 30 m would stand in the driveway; the next, at 50 m, stands.
+  EXPECT_NE(down(scene, 30, -4.6).second, "vehicle_paint");
+  EXPECT_EQ(down(scene, 50, -4.6).second, "vehicle_paint");
+  // Verge (left side): grass away from the driveway, paved across it.
+  EXPECT_EQ(down(scene, 15, 4.65).second, "grass");
+  EXPECT_NE(down(scene, 30, 4.65).second, "grass");
 }
 
 TEST(Roadside, BollardsAndHydrantsStandWhereTheirRowsPutThem) {
@@ -74,10 +112,13 @@ TEST(Roadside, BollardsAndHydrantsStandWhereTheirRowsPutThem) {
 TEST(Roadside, AGrassVergeLiesBetweenTheCurbAndTheSidewalk) {
   const World w = test::world_from_yaml(kWorld);
   const RayScene scene(w.mesh);
-  // Verge from 4 + 0.15 (curb top) + 0.3 = 4.45 m to 5.45 m from the centreline, on the left side.
+  // Verge right behind the curb's top, from 4 + 0.15 = 4.15 m to 5.15 m from the centreline, on the
+  // left side (the hedge covers it on the right).
   EXPECT_EQ(down(scene, 20, 4.95).second, "grass");
   EXPECT_NEAR(down(scene, 20, 4.95).first, 0.15 + 0.01, 0.01);
-  EXPECT_NE(down(scene, 20, 5.8).second, "grass");
+  EXPECT_EQ(down(scene, 20, 4.2).second, "grass");
+  EXPECT_EQ(down(scene, 20, 4.1).second, "curb_concrete");
+  EXPECT_NE(down(scene, 20, 5.2).second, "grass");
 }
 
 TEST(Roadside, BadValuesAreErrorsAtTheirLine) {
