@@ -192,6 +192,13 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
   s.world = y.string(root.required("world"), "world");
   s.duration_s = y.number_in(root.required("duration_s"), "duration_s", 0.1, kMaxDuration);
   root.integer("seed", s.seed, 0, uint64_t(1) << 62);
+  // The profile first: it sets the defaults that the sections below override.
+  if (const YAML::Node r = root["realism"]) {
+    const std::string word = y.string(r, "realism");
+    const std::optional<Realism> profile = parse_realism(word);
+    if (!profile) y.fail(r, "realism must be ideal, typical or harsh, got '" + word + "'");
+    s.realism = *profile;
+  }
   s.ego = read_ego(y, root.required("ego"), vehicle);
   if (const YAML::Node n = root["lidar"]) read_hdl32e_config(y, n, s.lidar);
   if (const YAML::Node n = root["can"]) read_can(y, n, s.can);

@@ -12,6 +12,7 @@
 #include "sim/gps_model.hpp"
 #include "sim/hdl32e.hpp"
 #include "sim/path.hpp"
+#include "sim/realism.hpp"
 #include "sim/traffic.hpp"
 #include "sim/vehicle_model.hpp"
 #include "sim/world_builder.hpp"
@@ -75,6 +76,8 @@ struct Scenario {
   std::string world = "campus";  // a name under maps/ or a path
   double duration_s = 60;
   uint64_t seed = 1;
+  // Selects the defaults of every realism knob below; the sections override them (sim/realism.hpp).
+  Realism realism = Realism::typical;
   EgoSpec ego;
   Hdl32eConfig lidar;
   CanConfig can;
