@@ -4,11 +4,12 @@
 
 #include "common/input_error.hpp"
 #include "loop/map_cache.hpp"
+#include "loop/mapping_drive.hpp"
 
 namespace lidarloop {
 
-LoadedScenario load_scenario_and_world(const std::string& path) {
-  Scenario scenario = load_scenario(path, load_vehicle_params(data_dir() + "/assets/vehicle.yaml"));
+LoadedScenario load_scenario_and_world(const std::string& path, std::optional<Realism> realism) {
+  Scenario scenario = load_scenario(path, load_vehicle_params(data_dir() + "/assets/vehicle.yaml"), realism);
   LoadedWorld world = load_scenario_world(scenario);
   ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
   // The localizer section is the localizer's to check; do it now so that a typo fails before a run.
@@ -16,8 +17,17 @@ LoadedScenario load_scenario_and_world(const std::string& path) {
   return {std::move(scenario), std::move(world), std::move(resolved)};
 }
 
+MappingOptions scenario_mapping_options(const Scenario& scenario) {
+  MappingOptions options = mapping_options_for(scenario.realism);
+  if (!scenario.text.empty()) {
+    const YamlReader y = YamlReader::from_string(scenario.text, scenario.file);
+    if (y.root().IsMap() && y.root()["survey"]) read_survey_options(y, y.root()["survey"], options);
+  }
+  return options;
+}
+
 HdMap open_scenario_map(const Scenario& scenario, const LoadedWorld& world) {
-  const MapLocation map = ensure_map(scenario.world, MappingOptions{}, false);
+  const MapLocation map = ensure_map(scenario.world, scenario_mapping_options(scenario), false);
   return open_hd_map(map.dir, world.description.name);
 }
 

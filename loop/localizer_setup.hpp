@@ -7,6 +7,7 @@
 
 #include "localizer/hd_map.hpp"
 #include "localizer/localizer_params.hpp"
+#include "loop/mapping_drive.hpp"
 #include "sim/scenario.hpp"
 #include "sim/world_assets.hpp"
 
@@ -18,7 +19,12 @@ struct LoadedScenario {
   ResolvedScenario resolved;
 };
 // InputError naming the file for anything wrong with the scenario or its world.
-LoadedScenario load_scenario_and_world(const std::string& path);
+// `realism` replaces the scenario's own profile (a command's --realism).
+LoadedScenario load_scenario_and_world(const std::string& path, std::optional<Realism> realism = std::nullopt);
+
+// The survey the scenario's map is made by: its realism profile's (mapping_options_for), then the
+// scenario's `survey` section.
+MappingOptions scenario_mapping_options(const Scenario& scenario);
 
 // Finds or builds the map of the scenario's world (progress on a terminal) and opens it, checking
 // that it is the map of `world`.

@@ -61,7 +61,7 @@ MapLocation ensure_map(const std::string& world_name, const MappingOptions& opti
   const std::string world_path = world_file(world_name);
   MapLocation loc;
   loc.hash = map_hash(world_name, options);
-  const LoadedWorld w = load_world(world_path);
+  const LoadedWorld w = load_mapped_world(world_path, options);
   loc.dir = map_cache_root() + "/" + w.world.name + "-" + loc.hash;
   if (!force && fs::exists(loc.dir + "/map.yaml")) {
     const IntensityMapHeader header = read_intensity_map_header(loc.dir);

@@ -6,6 +6,7 @@
 
 #include "common/units.hpp"
 #include "sim/actor_assets.hpp"
+#include "sim/hdl32e.hpp"
 #include "sim/lidar_scanner.hpp"
 #include "sim/path.hpp"
 #include "sim/road_surface.hpp"
@@ -28,7 +29,39 @@ std::string MappingOptions::describe() const {
   s << "traffic=" << traffic << " speed=" << speed << " resolution=" << resolution << " tile_cells=" << tile_cells
     << " max_ground_height=" << max_ground_height << " max_range=" << max_range << " seed=" << seed
     << " survey_unit_serial=" << survey_unit_serial << " " << survey_error.describe();
+  if (ideal_ground) s << " ideal_ground=1";  // absent when off, so typical maps keep their cache key
   return s.str();
+}
+
+MappingOptions mapping_options_for(Realism realism) {
+  MappingOptions o;
+  switch (realism) {
+    case Realism::ideal:
+      o.survey_error.sigma_xy_m = 0;
+      o.survey_error.heading_sigma_rad = 0;
+      o.survey_unit_serial = Hdl32eConfig{}.unit_serial;  // the test car's own unit
+      o.ideal_ground = true;
+      break;
+    case Realism::typical:
+      break;  // the defaults: an RTK-INS survey (SurveyErrorConfig)
+    case Realism::harsh:
+      // A survey driven without an RTK fix (code-differential GNSS aiding the INS). Assumption: the
+      // position error five times the RTK column's 2 cm and the heading error twice its 0.05 deg; the
+      // Applanix datasheet's DGPS column is worse still (decimetres), so this is a mild "harsh".
+      o.survey_error.sigma_xy_m = 0.10;
+      o.survey_error.heading_sigma_rad = 0.10 * kDeg;
+      break;
+  }
+  return o;
+}
+
+LoadedWorld load_mapped_world(const std::string& world, const MappingOptions& options) {
+  LoadedWorld w = load_world(world);
+  if (options.ideal_ground) {
+    w.description = on_ideal_ground(std::move(w.description));
+    w.world = build_world(w.description, w.materials, actors_dir());
+  }
+  return w;
 }
 
 void read_survey_options(const YamlReader& yaml, const YAML::Node& node, MappingOptions& o) {

@@ -12,6 +12,8 @@
 #include "localizer/intensity_map.hpp"
 #include "loop/survey_map.hpp"
 #include "sim/materials.hpp"
+#include "sim/realism.hpp"
+#include "sim/world_assets.hpp"
 #include "sim/world_builder.hpp"
 
 namespace lidarloop {
@@ -30,9 +32,20 @@ struct MappingOptions {
   // The survey car's HDL-32E (Hdl32eConfig::unit_serial): another unit than the test car's, whose
   // default serial is 1, so the map's per-laser intensity gains are not the scans'.
   uint64_t survey_unit_serial = 2;
+  // Map the world on ideal ground (flat roads, ideal curbs: on_ideal_ground), as the `ideal` profile's
+  // car drives it.
+  bool ideal_ground = false;
 
   std::string describe() const;  // every option as text, for the cache key and the map header
 };
+
+// The mapping options of a realism profile (sim/realism.hpp): the `typical` map is the defaults above (an
+// RTK-INS survey by another HDL-32E unit); `ideal` is the world itself (no pose error, the test car's own
+// unit, ideal ground); `harsh` is a survey that had no RTK fix (see mapping_drive.cpp for the figures).
+MappingOptions mapping_options_for(Realism realism);
+
+// The world a map with these options is built from: the world file, on ideal ground if options say so.
+LoadedWorld load_mapped_world(const std::string& world, const MappingOptions& options);
 
 // Overrides of the survey settings from a YAML mapping: unit_serial, sigma_xy_m, correlation_length_m,
 // heading_sigma_deg, heading_correlation_length_m, sample_spacing_m.

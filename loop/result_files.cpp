@@ -113,6 +113,7 @@ std::string metrics_json(const Metrics& m) {
   const json doc = {
       {"method", m.method},
       {"scenario", m.scenario},
+      {"realism", {{"profile", m.realism}, {"overrides", m.realism_overrides}}},
       {"frames", m.frames},
       {"unscored_frames", m.unscored_frames},
       {"settling_frames", m.settling_frames},

@@ -54,6 +54,8 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
   const std::vector<EstimateRecord> estimates = estimate_records(all_estimates);
   const std::vector<TruthPose> truth = truth_poses(truth_samples);
   ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name);
+  scored.metrics.realism = realism_name(scenario.realism);
+  scored.metrics.realism_overrides = realism_overrides(scenario);
 
   std::filesystem::create_directories(dir);
   write_metrics_json(dir + "/metrics.json", scored.metrics);

@@ -1,9 +1,17 @@
 #include "loop/run_recording.hpp"
 
 #include "common/input_error.hpp"
+#include "loop/localizer_setup.hpp"
 #include "loop/map_cache.hpp"
 
 namespace lidarloop {
+namespace {
+std::string join_lines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const auto& l : lines) out += (out.empty() ? "" : "\n") + l;
+  return out;
+}
+}  // namespace
 
 void RecordingSink::on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) {
   std::vector<ros2::ActorState> states;
@@ -25,7 +33,9 @@ std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>&
                                   {"duration_s", std::to_string(scenario.duration_s)},
                                   {"method", method},
                                   {"loop", scenario.closed_loop ? "closed" : "open"},
-                                  {"map_hash", map_hash(scenario.world, MappingOptions{})},
+                                  {"map_hash", map_hash(scenario.world, scenario_mapping_options(scenario))},
+                                  {"realism", realism_name(scenario.realism)},
+                                  {"realism_overrides", join_lines(realism_overrides(scenario))},
                                   {"version", LIDARLOOP_VERSION}});
   return recorder;
 }

@@ -51,6 +51,9 @@ struct FrameError {
 
 struct Metrics {
   std::string method, scenario;
+  // The run's realism profile and the knobs the scenario set on top of it (labels, not scored).
+  std::string realism;
+  std::vector<std::string> realism_overrides;
   size_t frames = 0;           // estimates scored
   size_t unscored_frames = 0;  // estimates outside the truth's time range (not scored, reported)
   size_t settling_frames = 0;  // estimates within thresholds.settle_s of the first (not scored)

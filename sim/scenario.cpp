@@ -184,7 +184,7 @@ TrafficSpec read_actor(const YamlReader& y, const YAML::Node& n) {
   return a;
 }
 
-Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
+Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<Realism> realism) {
   YamlMap root(y, y.root(), "a scenario");
   Scenario s;
   s.file = y.file();
@@ -199,6 +199,7 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
     if (!profile) y.fail(r, "realism must be ideal, typical or harsh, got '" + word + "'");
     s.realism = *profile;
   }
+  if (realism) s.realism = *realism;
   s.ego = read_ego(y, root.required("ego"), vehicle);
   if (const YAML::Node n = root["lidar"]) read_hdl32e_config(y, n, s.lidar);
   if (const YAML::Node n = root["can"]) read_can(y, n, s.can);
@@ -224,6 +225,8 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle) {
   // How today's world differs from the surveyed one: applied, and checked, with the world
   // (load_scenario_world), since its positions refer to the world's roads.
   if (const YAML::Node changes = root["world_changes"]) y.expect_map(changes, "world_changes");
+  // The map's survey settings (loop/mapping_drive.hpp's read_survey_options), read with the map.
+  if (const YAML::Node survey = root["survey"]) y.expect_map(survey, "survey");
   if (const YAML::Node loop = root["loop"]) s.closed_loop = read_choice(y, loop, "loop", "open", "closed");
   YamlMap pass(y, root["pass"], "pass");
   pass.number("lateral_rmse_m", s.pass.lateral_rmse_m, 0.0, 1e4)
@@ -272,11 +275,38 @@ void check_on_network(const Path& path, const region::Paths& area, const std::st
 
 }  // namespace
 
-Scenario load_scenario(const std::string& path, const VehicleParams& vehicle) {
-  return parse(YamlReader::open(path), vehicle);
+Scenario load_scenario(const std::string& path, const VehicleParams& vehicle, std::optional<Realism> realism) {
+  return parse(YamlReader::open(path), vehicle, realism);
 }
-Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle) {
-  return parse(YamlReader::from_string(yaml_text, name), vehicle);
+Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle,
+                        std::optional<Realism> realism) {
+  return parse(YamlReader::from_string(yaml_text, name), vehicle, realism);
+}
+
+namespace {
+void list_scalars(const YAML::Node& node, const std::string& path, std::vector<std::string>& out) {
+  if (node.IsScalar()) {
+    out.push_back(path + " = " + node.Scalar());
+  } else if (node.IsMap()) {
+    for (const auto& kv : node) list_scalars(kv.second, path + "." + kv.first.Scalar(), out);
+  } else if (node.IsSequence()) {
+    for (size_t i = 0; i < node.size(); ++i) list_scalars(node[i], path + "[" + std::to_string(i) + "]", out);
+  }
+}
+}  // namespace
+
+std::vector<std::string> realism_overrides(const Scenario& scenario) {
+  std::vector<std::string> out;
+  if (scenario.text.empty()) return out;
+  const YAML::Node root = YAML::Load(scenario.text);
+  if (!root.IsMap()) return out;
+  for (const auto& kv : root) {
+    const std::string key = kv.first.Scalar();
+    for (const char* section :
+         {"lidar", "body", "weather", "clocks", "mount_error", "can", "gps", "rtk", "survey", "world_changes"})
+      if (key == section) list_scalars(kv.second, key, out);
+  }
+  return out;
 }
 
 ResolvedScenario resolve_scenario(const Scenario& s, const WorldDescription& d, const World& world) {

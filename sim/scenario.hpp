@@ -95,8 +95,17 @@ struct Scenario {
 };
 
 // `vehicle`: the ego's parameters before the scenario's own overrides (assets/vehicle.yaml).
-Scenario load_scenario(const std::string& path, const VehicleParams& vehicle = {});
-Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle = {});
+// `realism`: a profile that replaces the scenario's own (a command's --realism); the sections' overrides
+// still apply on top of it.
+Scenario load_scenario(const std::string& path, const VehicleParams& vehicle = {},
+                       std::optional<Realism> realism = std::nullopt);
+Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle = {},
+                        std::optional<Realism> realism = std::nullopt);
+
+// The realism knobs the scenario sets itself, on top of its profile: every scalar under the sections
+// that hold knobs (lidar, body, weather, clocks, mount_error, can, gps, rtk, survey, world_changes), as
+// "section.key = value" in file order, so a report can say how a run differs from its profile.
+std::vector<std::string> realism_overrides(const Scenario& scenario);
 
 struct ResolvedScenario {
   Path ego_route;

@@ -36,12 +36,16 @@ LoadedWorld load_world(const std::string& name_or_path) {
 
 LoadedWorld load_scenario_world(const Scenario& scenario) {
   LoadedWorld w = load_world(scenario.world);
-  if (scenario.text.empty()) return w;
-  const YamlReader y = YamlReader::from_string(scenario.text, scenario.file);
-  const YAML::Node changes = y.root().IsMap() ? y.root()["world_changes"] : YAML::Node();
-  if (!changes) return w;
-  w.description = apply_world_changes(std::move(w.description), y, changes);
-  w.world = build_world(w.description, w.materials, actors_dir());
+  // The `ideal` profile drives (and maps) the world on ideal ground: flat roads, ideal curbs.
+  const bool ideal = scenario.realism == Realism::ideal;
+  if (ideal) w.description = on_ideal_ground(std::move(w.description));
+  bool changed = false;
+  if (!scenario.text.empty()) {
+    const YamlReader y = YamlReader::from_string(scenario.text, scenario.file);
+    const YAML::Node changes = y.root().IsMap() ? y.root()["world_changes"] : YAML::Node();
+    if (changes) w.description = apply_world_changes(std::move(w.description), y, changes), changed = true;
+  }
+  if (ideal || changed) w.world = build_world(w.description, w.materials, actors_dir());
   return w;
 }
 

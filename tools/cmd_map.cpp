@@ -24,7 +24,12 @@ namespace lidarloop {
 namespace {
 
 MappingOptions mapping_options(const Args& args) {
-  MappingOptions o;
+  std::optional<Realism> realism = Realism::typical;
+  if (const auto word = args.value("realism")) {
+    realism = parse_realism(*word);
+    if (!realism) throw InputError("--realism must be ideal, typical or harsh, got '" + *word + "'");
+  }
+  MappingOptions o = mapping_options_for(*realism);
   o.traffic = args.flag("traffic");
   o.resolution = args.number("resolution", o.resolution);
   if (o.resolution < 0.05 || o.resolution > 2.0) throw InputError("--resolution must be 0.05 to 2 m");
@@ -41,7 +46,7 @@ MappingOptions mapping_options(const Args& args) {
 // the figures are printed whether the map was built now or found in the cache.
 void print_survey(const std::string& world, const MappingOptions& o, const std::string& map_dir) {
   constexpr double kCm = 100.0;
-  const LoadedWorld w = load_world(world);
+  const LoadedWorld w = load_mapped_world(world, o);
   const SurveyDrive survey = mapping_survey(w.description, o);
   double east2 = 0, north2 = 0, heading2 = 0, max_position = 0, max_heading = 0;
   for (const Pose2d& e : survey.error.samples) {
@@ -137,7 +142,8 @@ int bench_map(const Args& args) {
 
 Command map_command() {
   return {{"map",
-           "lidarloop map WORLD [--traffic] [--force] [--resolution M] [--speed V] [--survey FILE.yaml]",
+           "lidarloop map WORLD [--traffic] [--force] [--resolution M] [--speed V] [--realism PROFILE]\n"
+           "                    [--survey FILE.yaml]",
            "Build a world's HD map by a mapping drive over every lane (or find it in the cache): the curb\n"
            "layer (GeoJSON) and the intensity layer (tiles of per-cell count, mean and variance, Eq. 8).\n"
            "The map is a survey: scans placed with an RTK-INS pose error, by another HDL-32E unit, and the\n"
@@ -146,6 +152,7 @@ Command map_command() {
             {"force", "", "rebuild even if the cache has this map"},
             {"resolution", "M", "intensity cell size (default 0.2 m)"},
             {"speed", "M_S", "mapping drive speed (default 15 m/s)"},
+            {"realism", "PROFILE", "the survey of a realism profile: ideal, typical (default) or harsh"},
             {"survey", "FILE", "survey settings in YAML (unit_serial, sigma_xy_m, heading_sigma_deg, ...)"},
             {"threads", "N", "worker threads (default: all cores)"}},
            1,

@@ -48,8 +48,14 @@ int run_replay(const Args& args) {
   bool more = reader.next(message);
   const RecordedRun run = recorded_run(reader, log);
 
-  Scenario scenario =
-      parse_scenario(run.scenario_text, run.scenario_name, load_vehicle_params(data_dir() + "/assets/vehicle.yaml"));
+  // The profile the run had (a --realism on its command line is not in the scenario's text).
+  std::optional<Realism> realism;
+  if (run.metadata.count("realism")) {
+    realism = parse_realism(run.metadata.at("realism"));
+    if (!realism) throw InputError(log + ": metadata " + kRunMetadata + " has an unknown realism profile");
+  }
+  Scenario scenario = parse_scenario(run.scenario_text, run.scenario_name,
+                                     load_vehicle_params(data_dir() + "/assets/vehicle.yaml"), realism);
   try {
     scenario.seed = std::stoull(run.metadata.at("seed"));
   } catch (const std::exception&) {

@@ -26,11 +26,24 @@ constexpr size_t kObstacleScanPoints = 20;
 
 // The scenario named on the command line, with --seed and --duration applied.
 LoadedScenario load_with_overrides(const Args& args) {
-  LoadedScenario s = load_scenario_and_world(args.positional().at(0));
+  std::optional<Realism> realism;
+  if (const auto word = args.value("realism")) {
+    realism = parse_realism(*word);
+    if (!realism) throw InputError("--realism must be ideal, typical or harsh, got '" + *word + "'");
+  }
+  LoadedScenario s = load_scenario_and_world(args.positional().at(0), realism);
   if (args.value("seed")) s.scenario.seed = uint64_t(args.integer("seed", 0, 0, 1L << 62));
   if (args.value("duration")) s.scenario.duration_s = args.number("duration", s.scenario.duration_s);
   if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");
   return s;
+}
+
+// The realism profile and the knobs the scenario sets on top of it.
+void print_realism(const Scenario& s) {
+  const std::vector<std::string> overrides = realism_overrides(s);
+  std::printf("realism    %s%s\n", realism_name(s.realism),
+              overrides.empty() ? ", no knob overridden" : ", with the scenario's own settings:");
+  for (const auto& o : overrides) std::printf("           %s\n", o.c_str());
 }
 
 struct Progress {
@@ -83,6 +96,7 @@ int run_run(const Args& args) {
   std::printf("\nscenario   %s (seed %llu, %s loop), %.1f s simulated in %.1f s wall (%.1fx real time, %d thread(s))\n",
               s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.closed_loop ? "closed" : "open",
               s.scenario.duration_s, r.wall_s, s.scenario.duration_s / r.wall_s, threads);
+  print_realism(s.scenario);
   std::printf("localizer  %zu scans, %.2f ms per scan on average, %.1f%% of the loop's time\n", r.scans,
               1e3 * r.localizer_wall_s / double(std::max<size_t>(r.scans, 1)), 100 * r.localizer_wall_s / r.wall_s);
   std::printf("lane       the car stayed within %.2f m of its lane's centre\n", lane_offset);
@@ -169,6 +183,7 @@ int run_compare(const Args& args) {
   std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n",
               s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.duration_s, r.scans,
               metrics.size());
+  print_realism(s.scenario);
   std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, <method>/...)\n", out.c_str());
   if (const auto best = args.value("expect-best")) return expect_best(metrics, *best);
   return 0;
@@ -187,6 +202,7 @@ Command run_command() {
             {"loop", "open|closed", "closed: the controller steers on the estimate (default: the scenario's)"},
             {"out", "DIR", "output folder (default out/<scenario name>)"},
             {"seed", "N", "override the scenario's seed"},
+            {"realism", "PROFILE", "ideal, typical or harsh: replaces the scenario's realism profile"},
             {"duration", "S", "override the scenario's duration, seconds"},
             {"record", "FILE.mcap", "record every stream and the estimates as an MCAP log (replay redoes the run)"},
             {"threads", "N", "worker threads (default: all cores)"}},
@@ -204,6 +220,7 @@ Command compare_command() {
             {"expect-best", "NAME", "exit 1 unless this method has the lowest lateral, longitudinal and heading RMSE"},
             {"out", "DIR", "output folder (default out/<scenario name>-compare)"},
             {"seed", "N", "override the scenario's seed"},
+            {"realism", "PROFILE", "ideal, typical or harsh: replaces the scenario's realism profile"},
             {"duration", "S", "override the scenario's duration, seconds"},
             {"threads", "N", "worker threads (default: all cores)"}},
            1,
