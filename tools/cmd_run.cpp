@@ -11,6 +11,7 @@
 #include "common/input_error.hpp"
 #include "loop/localizer_loop.hpp"
 #include "loop/localizer_setup.hpp"
+#include "loop/paper_tables.hpp"
 #include "loop/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "loop/run_recording.hpp"
@@ -23,6 +24,14 @@ namespace {
 // A scan "has an obstacle in the corridor" with at least this many obstacle points (a pedestrian at
 // 30 m gives a few dozen; stray returns a handful).
 constexpr size_t kObstacleScanPoints = 20;
+constexpr size_t kMaxSeeds = 100;  // --seeds: a typo's guard, not a limit of the method
+
+void write_text(const std::string& path, const std::string& text) {
+  FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw InputError(path + ": cannot write file");
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+}
 
 // The scenario named on the command line, with --seed and --duration applied.
 LoadedScenario load_with_overrides(const Args& args) {
@@ -147,23 +156,21 @@ int expect_best(const std::vector<Metrics>& metrics, const std::string& method) 
   return best ? 0 : 1;
 }
 
-int run_compare(const Args& args) {
-  const int threads = thread_count(args);
-  const auto limit = limit_threads(threads);
-  LoadedScenario s = load_with_overrides(args);
+// Every method on one simulated drive of `s` (its own seed); each method's files under `out`.
+std::vector<Metrics> compare_once(const LoadedScenario& s, const std::vector<std::string>& methods, int threads,
+                                  const std::string& out, size_t& scans) {
   std::vector<LocalizerParams> params;
-  for (const auto& m : parse_methods(args.text("methods", "all")))
-    params.push_back(localizer_params_for(s.scenario, m));
+  for (const auto& m : methods) params.push_back(localizer_params_for(s.scenario, m));
   const std::string name = std::filesystem::path(s.scenario.file).stem().string();
-  const std::string out = args.text("out", "out/" + name + "-compare");
   std::filesystem::create_directories(out);
-
   HdMap map = open_scenario_map(s.scenario, s.world);
   // Open loop: every method sees the same drive; in closed loop each would drive its own.
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
-  const Progress progress{isatty(STDOUT_FILENO) != 0, "compare", s.scenario.duration_s};
+  const Progress progress{isatty(STDOUT_FILENO) != 0, "compare seed " + std::to_string(s.scenario.seed),
+                          s.scenario.duration_s};
   const LoopResult r = run_localizer_loop(sim, map, params, false, nullptr, std::ref(progress));
   progress.clear();
+  scans = r.scans;
 
   std::vector<Metrics> metrics;
   for (const auto& trace : r.methods)
@@ -172,21 +179,84 @@ int run_compare(const Args& args) {
                           .metrics);
   write_junit(out + "/junit.xml", metrics);
   write_comparison_csv(out + "/comparison.csv", metrics);
-  const std::string table = comparison_markdown(metrics);
-  if (FILE* f = std::fopen((out + "/comparison.md").c_str(), "w")) {
-    std::fputs(table.c_str(), f);
-    std::fclose(f);
-  } else {
-    throw InputError(out + "/comparison.md: cannot write file");
+  write_text(out + "/comparison.md", comparison_markdown(metrics));
+  return metrics;
+}
+
+// --seeds: "1,2,5" or "1-5".
+std::vector<uint64_t> parse_seeds(const std::string& text) {
+  std::vector<uint64_t> seeds;
+  const size_t dash = text.find('-');
+  try {
+    if (dash != std::string::npos) {
+      const uint64_t first = std::stoull(text.substr(0, dash)), last = std::stoull(text.substr(dash + 1));
+      if (last < first || last - first >= kMaxSeeds) throw std::invalid_argument("range");
+      for (uint64_t k = first; k <= last; ++k) seeds.push_back(k);
+    } else {
+      std::stringstream ss(text);
+      for (std::string item; std::getline(ss, item, ',');) seeds.push_back(std::stoull(item));
+    }
+  } catch (const std::exception&) {
+    throw InputError("--seeds: expected a list like 1,2,3 or a range like 1-5, got '" + text + "'");
   }
-  std::cout << table;
-  std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n",
-              s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.duration_s, r.scans,
-              metrics.size());
+  if (seeds.empty() || seeds.size() > kMaxSeeds) throw InputError("--seeds: give 1 to 100 seeds");
+  return seeds;
+}
+
+int run_compare(const Args& args) {
+  const int threads = thread_count(args);
+  const auto limit = limit_threads(threads);
+  LoadedScenario s = load_with_overrides(args);
+  const std::vector<std::string> methods = parse_methods(args.text("methods", "all"));
+  std::optional<PaperTable> paper;
+  if (const auto word = args.value("paper")) {
+    paper = parse_paper_table(*word);
+    if (!paper) throw InputError("--paper must be static or dynamic, got '" + *word + "'");
+  }
+  const std::string name = std::filesystem::path(s.scenario.file).stem().string();
+  const std::string out = args.text("out", "out/" + name + "-compare");
+  const auto expect = args.value("expect-best");
+
+  if (!args.value("seeds")) {
+    size_t scans = 0;
+    const std::vector<Metrics> metrics = compare_once(s, methods, threads, out, scans);
+    std::cout << comparison_markdown(metrics);
+    if (paper) std::cout << "\n" << paper_comparison_markdown(*paper, summarise_over_seeds(metrics));
+    std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n",
+                s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.duration_s, scans,
+                metrics.size());
+    print_realism(s.scenario);
+    std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, <method>/...)\n", out.c_str());
+    return expect ? expect_best(metrics, *expect) : 0;
+  }
+
+  // Several seeds: one drive each, then every method's mean and spread over them.
+  std::vector<Metrics> all;
+  int status = 0;
+  for (const uint64_t seed : parse_seeds(*args.value("seeds"))) {
+    s.scenario.seed = seed;
+    size_t scans = 0;
+    const std::vector<Metrics> metrics =
+        compare_once(s, methods, threads, out + "/seed_" + std::to_string(seed), scans);
+    all.insert(all.end(), metrics.begin(), metrics.end());
+    std::printf("seed %-5llu %zu scans:", (unsigned long long)seed, scans);
+    for (const Metrics& m : metrics)
+      std::printf(" %s %.3f/%.3f/%.3f", m.method.c_str(), m.lateral_rmse_m, m.longitudinal_rmse_m, m.heading_rmse_deg);
+    std::printf("\n");
+    if (expect && expect_best(metrics, *expect) != 0) status = 1;
+  }
+  const std::vector<MethodOverSeeds> summary = summarise_over_seeds(all);
+  const std::string table = paper ? paper_comparison_markdown(*paper, summary)
+                                  : paper_comparison_markdown(PaperTable::dynamic_campus, summary);
+  write_comparison_csv(out + "/comparison.csv", all);
+  write_text(out + "/seeds.md", table);
+  std::cout << "\n" << table;
+  std::printf("\nscenario   %s, %zu seeds (--seeds %s), %.1f s each; ours: mean (smallest-largest) over the seeds%s\n",
+              s.scenario.file.c_str(), all.size() / std::max<size_t>(methods.size(), 1), args.value("seeds")->c_str(),
+              s.scenario.duration_s, paper ? "" : "; paper: Table III (give --paper static for Table II)");
   print_realism(s.scenario);
-  std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, <method>/...)\n", out.c_str());
-  if (const auto best = args.value("expect-best")) return expect_best(metrics, *best);
-  return 0;
+  std::printf("files      %s/ (seeds.md, comparison.csv, seed_<N>/...)\n", out.c_str());
+  return status;
 }
 
 }  // namespace
@@ -213,11 +283,14 @@ Command run_command() {
 
 Command compare_command() {
   return {{"compare",
-           "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--expect-best NAME] [--out DIR] [--seed N]",
+           "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--expect-best NAME] [--out DIR] [--seed N]\n"
+           "                        [--seeds LIST] [--paper static|dynamic] [--realism PROFILE]",
            "Simulate a scenario once and feed the identical streams to several localizer methods; print\n"
            "and write a table like the paper's Table III (comparison.md, comparison.csv).",
            {{"methods", "LIST", "all, or a comma-separated list of methods (default all)"},
             {"expect-best", "NAME", "exit 1 unless this method has the lowest lateral, longitudinal and heading RMSE"},
+            {"seeds", "LIST", "run every seed of a list (1,2,3) or range (1-5); print each method's mean and spread"},
+            {"paper", "TABLE", "print the paper's Table II (static) or III (dynamic) beside ours"},
             {"out", "DIR", "output folder (default out/<scenario name>-compare)"},
             {"seed", "N", "override the scenario's seed"},
             {"realism", "PROFILE", "ideal, typical or harsh: replaces the scenario's realism profile"},
