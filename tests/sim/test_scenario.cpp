@@ -98,6 +98,8 @@ TEST(Scenario, MalformedScenariosAreRejectedWithTheirOwnMessage) {
       {"bad loop", edit("loop: closed", "loop: maybe"), "20:7", "loop must be open or closed"},
       {"unknown threshold", edit("heading_rmse_deg", "heading_rms_deg"), "21:29", "unknown key 'heading_rms_deg'"},
       {"duplicate key", edit("seed: 3\n", "seed: 3\nseed: 4\n"), "4:1", "key 'seed' appears twice"},
+      {"unknown realism", edit("seed: 3\n", "seed: 3\nrealism: gritty\n"), "4:10",
+       "realism must be ideal, typical or harsh, got 'gritty'"},
   };
   for (const auto& c : cases) {
     try {
@@ -109,6 +111,23 @@ TEST(Scenario, MalformedScenariosAreRejectedWithTheirOwnMessage) {
       EXPECT_NE(msg.find(c.message), std::string::npos) << c.name << ": " << msg;
     }
   }
+}
+
+TEST(Scenario, RealismIsTypicalUnlessTheScenarioOrTheCommandSaysOtherwise) {
+  EXPECT_EQ(parse_scenario(kValid, "valid.yaml").realism, Realism::typical);
+  const std::string harsh = edit("seed: 3\n", "seed: 3\nrealism: harsh\n");
+  EXPECT_EQ(parse_scenario(harsh, "harsh.yaml").realism, Realism::harsh);
+  EXPECT_EQ(parse_scenario(harsh, "harsh.yaml", {}, Realism::ideal).realism, Realism::ideal);
+}
+
+TEST(Scenario, RealismOverridesListTheKnobSectionsScalarsInFileOrder) {
+  const Scenario s = parse_scenario(kValid, "valid.yaml");
+  const std::vector<std::string> expected = {"lidar.rotation_hz = 20",         "can.latency_ms = 20",
+                                             "can.dropout_probability = 0.01", "gps.bias_sigma_m = 1.5",
+                                             "gps.zones[0].kind = outage",     "gps.zones[0].centre[0] = 300",
+                                             "gps.zones[0].centre[1] = 0",     "gps.zones[0].radius = 40",
+                                             "gps.zones[0].from_s = 5",        "gps.zones[0].to_s = 25"};
+  EXPECT_EQ(realism_overrides(s), expected);  // ego, traffic, localizer and pass are not realism knobs
 }
 
 class ScenarioOnCampus : public testing::Test {
