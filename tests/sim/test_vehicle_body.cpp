@@ -12,6 +12,7 @@
 #include "sim/ray_scene.hpp"
 #include "sim/road_surface.hpp"
 #include "sim/scenario.hpp"
+#include "sim/simulation.hpp"
 #include "sim/vehicle_body.hpp"
 #include "test_support.hpp"
 
@@ -176,6 +177,63 @@ TEST(VehicleBody, AScanFromAPitchedBodyMeetsTheGroundWhereGeometrySays) {
   EXPECT_NEAR(pitched_range, pitched_height / std::tan(kElevation + kPitch), 0.02);
   EXPECT_GT(rest_range - pitched_range, 0.8);  // ~0.87 m closer
   RecordProperty("ranges_m", std::to_string(rest_range) + " -> " + std::to_string(pitched_range));
+}
+
+struct Recorder : StreamSink {
+  std::vector<TruthSample> truth;
+  std::vector<std::pair<int64_t, Eigen::Isometry3d>> sensors;
+  void on_truth(const TruthSample& s) override { truth.push_back(s); }
+  void on_scan(const PointCloud& c, const Eigen::Isometry3d& pose) override { sensors.emplace_back(c.stamp_ns, pose); }
+};
+
+// A drive down a straight road that brakes for a stop, under `realism`.
+Recorder brake_for_a_stop(const std::string& realism, World& world, Scenario& scenario) {
+  const std::string world_yaml = R"(name: straight
+origin: {lat: 31.0, lon: 121.0}
+roads:
+  - {name: main, points: [[0, 0], [300, 0]], width: 7.0, lanes: 2, one_way: true, sidewalk_width: 3}
+)";
+  scenario = parse_scenario("world: straight\nduration_s: 6\nrealism: " + realism +
+                                "\nego: {route: {road: main, lane: left}, start_at: 40, speed: 8, initial_speed: 8, "
+                                "stops: [{at: 70, duration_s: 5}]}\n",
+                            "brake.yaml");
+  const WorldDescription description = parse_world_description(world_yaml, "straight.yaml");
+  world = build_world(description, test::materials(), test::data_path("assets/actors"));
+  Simulation sim(scenario, description, world, test::materials(), test::data_path("assets/actors"), 1);
+  Recorder rec;
+  sim.run(rec);
+  return rec;
+}
+
+TEST(VehicleBody, TheSimulationCastsScansFromTheBodyAndReportsIt) {
+  for (const std::string realism : {"typical", "ideal"}) {
+    SCOPED_TRACE(realism);
+    World world;
+    Scenario scenario;
+    const Recorder rec = brake_for_a_stop(realism, world, scenario);
+    const VehicleParams& car = scenario.ego.vehicle;
+    double max_pitch = 0;
+    for (const auto& t : rec.truth) max_pitch = std::max(max_pitch, t.body.pitch);
+    // Every scan's sensor pose is the ground plane at the truth's rear axle, times the body, times the mount.
+    size_t checked = 0;
+    for (const auto& [stamp, sensor] : rec.sensors)
+      for (const auto& t : rec.truth)
+        if (t.stamp_ns == stamp) {
+          const Eigen::Isometry3d want = rest_on_ground(t.pose, world.pavement(), car.wheelbase(), car.track_width) *
+                                         t.body.pose() * scenario.lidar.mount();
+          EXPECT_TRUE(sensor.isApprox(want, 1e-12)) << stamp;
+          ++checked;
+        }
+    EXPECT_GT(checked, 50u);
+    if (realism == "ideal") {
+      for (const auto& t : rec.truth) ASSERT_TRUE(t.body.pose().isApprox(Eigen::Isometry3d::Identity(), 0.0));
+    } else {
+      // The driver brakes comfortably for the stop: the nose dives by a visible fraction of a degree.
+      EXPECT_GT(max_pitch, 0.1 * kDeg);
+      EXPECT_LT(max_pitch, scenario.body.pitch_gradient_deg_per_g * kDeg * car.max_decel / kGravity * 1.5);
+      RecordProperty("max_pitch_deg", std::to_string(max_pitch * kDegPerRad));
+    }
+  }
 }
 
 }  // namespace
