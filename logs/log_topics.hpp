@@ -12,15 +12,20 @@
 //   /truth/odometry       nav_msgs/msg/Odometry             map -> base_link (speed, yaw rate as twist)
 //   /truth/state          lidarloop_msgs/msg/TruthState     map (lossless: replay scores against it)
 //   /truth/actors         lidarloop_msgs/msg/ActorArray     map
+//   /truth/body           geometry_msgs/msg/PoseStamped     base_link (the sprung body's frame on its suspension)
 //   /localizer/odometry   nav_msgs/msg/Odometry             map -> base_link_estimate (with covariance)
 //   /tf                   tf2_msgs/msg/TFMessage            map -> base_link (truth), map -> base_link_estimate
 //   /tf_static            tf2_msgs/msg/TFMessage            base_link -> lidar (mount), base_link -> gps
 //
 // Frames: map is the local transverse Mercator frame (x east, y north, z up); base_link is the
 // vehicle frame (x forward, y left, z up, origin at the rear axle centre on the ground); the GPS
-// antenna model sits at the base_link origin. Header stamps are measurement times; a message's MCAP
-// log_time is when the recorder received it in simulation time (never earlier than the log time of
-// the message before it), so replaying in log-time order gives exactly the order of the live run.
+// antenna model sits at the base_link origin. /truth/body is the pose, in base_link, of the body
+// frame: the frame that coincides with base_link when the body rests on flat ground, and that pitches
+// and rolls about the centre of mass and heaves with it (identity for a rigid body). The LiDAR is
+// mounted on the body: its true pose is base_link * body * mount, with the mount from /tf_static.
+// Header stamps are measurement times; a message's MCAP log_time is when the recorder received it in
+// simulation time (never earlier than the log time of the message before it), so replaying in
+// log-time order gives exactly the order of the live run.
 namespace lidarloop::log_topics {
 
 inline constexpr const char* scan = "/lidar/points";
@@ -32,6 +37,7 @@ inline constexpr const char* vehicle_report = "/vehicle/report";
 inline constexpr const char* truth_odometry = "/truth/odometry";
 inline constexpr const char* truth_state = "/truth/state";
 inline constexpr const char* truth_actors = "/truth/actors";
+inline constexpr const char* truth_body = "/truth/body";
 inline constexpr const char* estimate = "/localizer/odometry";
 inline constexpr const char* tf = "/tf";
 inline constexpr const char* tf_static = "/tf_static";

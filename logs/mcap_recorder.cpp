@@ -54,6 +54,7 @@ void McapRecorder::write_truth(const TruthSample& truth) {
   static constexpr ChannelSpec state{t::truth_state, "lidarloop_msgs/msg/TruthState"};
   static constexpr ChannelSpec odometry{t::truth_odometry, "nav_msgs/msg/Odometry"};
   static constexpr ChannelSpec tf{t::tf, "tf2_msgs/msg/TFMessage"};
+  static constexpr ChannelSpec body{t::truth_body, "geometry_msgs/msg/PoseStamped"};
   write(state, truth.stamp_ns, ros2::encode_truth_state(truth));
   ros2::Odometry odom =
       ros2::planar_odometry(truth.stamp_ns, truth.pose, Eigen::Matrix3d::Zero(), t::map_frame, t::vehicle_frame);
@@ -62,6 +63,7 @@ void McapRecorder::write_truth(const TruthSample& truth) {
   write(odometry, truth.stamp_ns, ros2::encode_odometry(odom));
   write(tf, truth.stamp_ns,
         ros2::encode_tf({ros2::planar_transform(truth.stamp_ns, t::map_frame, t::vehicle_frame, truth.pose)}));
+  write(body, truth.stamp_ns, ros2::encode_pose_stamped(truth.stamp_ns, t::vehicle_frame, truth.body.pose()));
 }
 
 void McapRecorder::write_can(const CanFrame& frame) {

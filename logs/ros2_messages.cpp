@@ -409,6 +409,23 @@ std::vector<Transform> decode_tf(View cdr, const std::string& context) {
   return out;
 }
 
+Bytes encode_pose_stamped(int64_t stamp_ns, const std::string& frame_id, const Eigen::Isometry3d& pose) {
+  CdrWriter w;
+  header(w, stamp_ns, frame_id);
+  vector3(w, pose.translation());
+  quaternion(w, Eigen::Quaterniond(pose.rotation()));
+  return std::move(w.buffer());
+}
+
+Transform decode_pose_stamped(View cdr, const std::string& context) {
+  CdrReader r(cdr, context);
+  Transform t;
+  t.stamp_ns = header(r, &t.parent);
+  t.translation = vector3(r);
+  t.rotation = quaternion(r);
+  return t;
+}
+
 Bytes encode_actor_array(int64_t stamp_ns, const std::vector<ActorState>& actors, const std::string& frame_id) {
   CdrWriter w;
   header(w, stamp_ns, frame_id);

@@ -102,6 +102,11 @@ Transform planar_transform(int64_t stamp_ns, const std::string& parent, const st
 Bytes encode_tf(const std::vector<Transform>& transforms);
 std::vector<Transform> decode_tf(View cdr, const std::string& context);
 
+// geometry_msgs/msg/PoseStamped: `pose` in frame `frame_id`. Decoded as a Transform with `parent` the
+// frame and `child` empty.
+Bytes encode_pose_stamped(int64_t stamp_ns, const std::string& frame_id, const Eigen::Isometry3d& pose);
+Transform decode_pose_stamped(View cdr, const std::string& context);
+
 // lidarloop_msgs/msg/ActorArray.
 struct ActorState {
   std::string name, type;

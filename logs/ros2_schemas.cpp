@@ -83,6 +83,9 @@ const std::map<std::string, std::string>& definitions() {
       {"geometry_msgs/Pose",
        "geometry_msgs/Point position\n"
        "geometry_msgs/Quaternion orientation\n"},
+      {"geometry_msgs/PoseStamped",
+       "std_msgs/Header header\n"
+       "geometry_msgs/Pose pose\n"},
       {"geometry_msgs/PoseWithCovariance",
        "geometry_msgs/Pose pose\n"
        "float64[36] covariance\n"},

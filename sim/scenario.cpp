@@ -205,6 +205,8 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   if (const YAML::Node n = root["can"]) read_can(y, n, s.can);
   if (const YAML::Node n = root["gps"]) read_gps(y, n, s.gps);
   if (const YAML::Node n = root["rtk"]) read_rtk(y, n, s.rtk);
+  s.body = body_config_for(s.realism);
+  read_body_config(y, root["body"], s.body);
   if (const YAML::Node t = root["traffic"]) {
     y.expect_sequence(t, "traffic");
     for (const auto& a : t) s.traffic.push_back(read_actor(y, a));

@@ -14,6 +14,7 @@
 #include "sim/path.hpp"
 #include "sim/realism.hpp"
 #include "sim/traffic.hpp"
+#include "sim/vehicle_body.hpp"
 #include "sim/vehicle_model.hpp"
 #include "sim/world_builder.hpp"
 
@@ -83,6 +84,7 @@ struct Scenario {
   CanConfig can;
   GpsConfig gps;
   RtkConfig rtk;
+  BodyConfig body;  // the ego's suspension (`body`)
   std::vector<TrafficSpec> traffic;
   // `localizer`: the method here; the rest of the section (parameter overrides) belongs to the
   // localizer and is read by the tools from `text`, since sim/ does not know the localizer.

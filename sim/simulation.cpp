@@ -3,12 +3,25 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/units.hpp"
+
 namespace lidarloop {
 
 constexpr int64_t kControlPeriodNs = 10'000'000;  // the driver acts at 100 Hz
 constexpr int64_t kTruthPeriodNs = 10'000'000;    // ground truth recorded at 100 Hz
 // Seeds of the sensors' random streams, derived from the scenario seed so each is independent.
 constexpr uint64_t kCanStream = 1, kGpsStream = 2, kRtkStream = 3, kLidarStream = 4;
+
+namespace {
+
+// The ground plane under the ego's wheels, where its suspension is attached (unused by a rigid body).
+GroundPlane plane_under(const Pose2d& rear_axle, const GroundHeight& pavement, const VehicleParams& v,
+                        const BodyConfig& body) {
+  if (body.rigid) return {};
+  return ground_plane(rest_on_ground(rear_axle, pavement, v.wheelbase(), v.track_width), v.lr);
+}
+
+}  // namespace
 
 Simulation::Simulation(const Scenario& scenario, const WorldDescription& description, const World& world,
                        const MaterialTable& materials, const std::string& actors_dir, int threads)
@@ -26,10 +39,13 @@ Simulation::Simulation(const Scenario& scenario, const WorldDescription& descrip
       rtk_(scenario.rtk, LocalFrame(description.origin), mix64(scenario.seed ^ kRtkStream)),
       control_period_ns_(kControlPeriodNs),
       ground_(world.ground()),
-      pavement_(world.pavement()) {
+      pavement_(world.pavement()),
+      body_(scenario.body, scenario.ego.vehicle,
+            plane_under(vehicle_.rear_axle_pose(), pavement_, scenario.ego.vehicle, scenario.body)) {
   add_actors(*scene_, resolved_.actors, actors_dir, materials, ground_);
   actor_poses_ = actor_motion(resolved_.actors, ground_);
   trajectory_.push_back(vehicle_.rear_axle_pose());
+  body_trajectory_.push_back(body_.attitude());
 }
 
 Simulation::~Simulation() = default;
@@ -58,16 +74,22 @@ void Simulation::step(StreamSink& sink) {
     const Pose2d believed = pose_source_ ? pose_source_(now_, truth) : truth;
     command_ = controller_.update(now_, believed, vehicle_.state().vx);
   }
+  const VehicleState before = vehicle_.state();
   vehicle_.step(command_.command);
   now_ += vp.step_ns;
   const Pose2d pose = vehicle_.rear_axle_pose();
   trajectory_.push_back(pose);
+  if (!scenario_.body.rigid) {
+    const double dt = ns_to_s(vp.step_ns);
+    body_.step(dt, planar_acceleration(before, vehicle_.state(), dt), plane_under(pose, pavement_, vp, scenario_.body));
+  }
+  body_trajectory_.push_back(body_.attitude());
 
   if (now_ % can_.period_ns() == 0) can_.measure(now_, vehicle_.wheel_speeds(), vehicle_.steering_wheel_angle());
   for (const CanFrame& f : can_.deliver(now_)) sink.on_can(f);
   if (now_ % kTruthPeriodNs == 0) {
     const VehicleState& s = vehicle_.state();
-    sink.on_truth({now_, pose, s.vx, s.yaw_rate, s.steer, command_.cross_track});
+    sink.on_truth({now_, pose, s.vx, s.yaw_rate, s.steer, command_.cross_track, body_.attitude()});
   }
   if (now_ % gps_.period_ns() == 0) sink.on_gps(gps_.sample(now_, pose));
   if (now_ % rtk_.period_ns() == 0) sink.on_rtk(rtk_.sample(now_, pose));
@@ -76,16 +98,27 @@ void Simulation::step(StreamSink& sink) {
 
 void Simulation::emit_scan(StreamSink& sink) {
   // The scan that started at trajectory_start_ns_ is complete: the vehicle's path through it is known.
+  // Every firing is cast from the body's pose at its time: the ground plane under the wheels at the
+  // rear axle's pose, times the body's attitude on it (the LiDAR mount is on the body).
   const int64_t stamp = trajectory_start_ns_, step_ns = scenario_.ego.vehicle.step_ns;
   const std::vector<Pose2d>& poses = trajectory_;
+  const std::vector<BodyAttitude>& bodies = body_trajectory_;
+  const bool rigid = scenario_.body.rigid;
   const PoseAt vehicle_pose = [&](int64_t t) {
     const double u = double(t - stamp) / double(step_ns);
     const size_t i = std::min(poses.size() - 2, size_t(std::max(0.0, std::floor(u))));
     const double f = std::clamp(u - double(i), 0.0, 1.0);
     const Pose2d &a = poses[i], &b = poses[i + 1];
     const VehicleParams& v = scenario_.ego.vehicle;
-    return rest_on_ground({a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), a.yaw + f * wrap_angle(b.yaw - a.yaw)},
-                          pavement_, v.wheelbase(), v.track_width);
+    const Eigen::Isometry3d ground =
+        rest_on_ground({a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), a.yaw + f * wrap_angle(b.yaw - a.yaw)}, pavement_,
+                       v.wheelbase(), v.track_width);
+    if (rigid) return ground;
+    BodyAttitude body = bodies[i];
+    body.heave += f * (bodies[i + 1].heave - body.heave);
+    body.pitch += f * (bodies[i + 1].pitch - body.pitch);
+    body.roll += f * (bodies[i + 1].roll - body.roll);
+    return Eigen::Isometry3d(ground * body.pose());
   };
   const PointCloud cloud =
       scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses_);
@@ -95,6 +128,7 @@ void Simulation::emit_scan(StreamSink& sink) {
   sink.on_actors(stamp, states);
   ++scan_index_;
   trajectory_.erase(trajectory_.begin(), trajectory_.end() - 1);
+  body_trajectory_.erase(body_trajectory_.begin(), body_trajectory_.end() - 1);
   trajectory_start_ns_ = now_;
 }
 

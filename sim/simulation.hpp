@@ -10,6 +10,7 @@
 #include "common/point_cloud.hpp"
 #include "sim/lidar_scanner.hpp"
 #include "sim/scenario.hpp"
+#include "sim/vehicle_body.hpp"
 
 namespace lidarloop {
 
@@ -48,6 +49,7 @@ class Simulation {
   int64_t end_ns() const { return scenario_.duration_ns(); }
   const ResolvedScenario& resolved() const { return resolved_; }
   const VehicleModel& vehicle() const { return vehicle_; }
+  const VehicleBody& body() const { return body_; }
 
  private:
   void step(StreamSink& sink);
@@ -69,8 +71,10 @@ class Simulation {
   int64_t control_period_ns_;
   GroundHeight ground_;    // where actors stand
   GroundHeight pavement_;  // where the ego's wheels roll
+  VehicleBody body_;       // the sprung body the LiDAR is mounted on
   int64_t scan_index_ = 0;
-  std::vector<Pose2d> trajectory_;  // rear-axle pose at every step of the scan being recorded
+  std::vector<Pose2d> trajectory_;             // rear-axle pose at every step of the scan being recorded
+  std::vector<BodyAttitude> body_trajectory_;  // the body on the ground plane at the same steps
   int64_t trajectory_start_ns_ = 0;
 };
 

@@ -12,7 +12,9 @@ CsvStreams::CsvStreams(const std::string& dir, const LocalFrame& frame, int scan
   std::error_code ec;
   std::filesystem::create_directories(dir + "/scans", ec);
   if (ec) throw InputError(dir + ": cannot create output folder (" + ec.message() + ")");
-  truth_ = open("truth.csv", "stamp_ns,x_m,y_m,yaw_rad,speed_mps,yaw_rate_radps,steer_rad,cross_track_m");
+  truth_ = open("truth.csv",
+                "stamp_ns,x_m,y_m,yaw_rad,speed_mps,yaw_rate_radps,steer_rad,cross_track_m,body_heave_m,"
+                "body_pitch_rad,body_roll_rad");
   can_ = open("can.csv", "stamp_ns,wheel_fl_mps,wheel_fr_mps,wheel_rl_mps,wheel_rr_mps,steering_wheel_rad");
   gps_ = open("gps.csv",
               "stamp_ns,status,lat_deg,lon_deg,alt_m,heading_rad,var_east_m2,var_north_m2,var_heading_rad2,x_m,y_m");
@@ -31,7 +33,8 @@ std::ofstream CsvStreams::open(const std::string& name, const std::string& heade
 
 void CsvStreams::on_truth(const TruthSample& s) {
   truth_ << s.stamp_ns << ',' << s.pose.x << ',' << s.pose.y << ',' << s.pose.yaw << ',' << s.speed << ',' << s.yaw_rate
-         << ',' << s.steer << ',' << s.cross_track << '\n';
+         << ',' << s.steer << ',' << s.cross_track << ',' << s.body.heave << ',' << s.body.pitch << ',' << s.body.roll
+         << '\n';
   if (ego_path_.empty() || (ego_path_.back() - Eigen::Vector2d(s.pose.x, s.pose.y)).norm() > 0.5)
     ego_path_.emplace_back(s.pose.x, s.pose.y);
   cross_track_sq_ += s.cross_track * s.cross_track;

@@ -59,7 +59,8 @@ inline SyntheticRun make_synthetic_run(double seconds, int points, uint64_t seed
                   10 + u(rng),
                   0.01 * u(rng),
                   0.02 * u(rng),
-                  0.05 * u(rng)};
+                  0.05 * u(rng),
+                  {0.01 * u(rng), 0.02 * u(rng), 0.02 * u(rng), {1.2, 0, 0.7}}};
     run.truth.push_back(s);
     CanFrame c;
     c.stamp_ns = t + 2'000'000;  // bus latency: later than the truth of the same step

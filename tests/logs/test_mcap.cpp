@@ -82,6 +82,8 @@ void decode(const McapMessage& m) {
     ros2::decode_odometry(m.data, "test");
   else if (type == "tf2_msgs/msg/TFMessage")
     ros2::decode_tf(m.data, "test");
+  else if (type == "geometry_msgs/msg/PoseStamped")
+    ros2::decode_pose_stamped(m.data, "test");
   else if (type == "lidarloop_msgs/msg/ActorArray")
     ros2::decode_actor_array(m.data, "test");
 }
@@ -206,7 +208,7 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
   std::vector<PointCloud> scans;
   std::vector<ros2::Odometry> estimates, truth_odometry;
   std::vector<std::vector<ros2::ActorState>> actors;
-  std::vector<ros2::Transform> tf_static;
+  std::vector<ros2::Transform> tf_static, bodies;
   size_t tf = 0;
   uint64_t last_log_time = 0;
   for (McapMessage m; reader.next(m);) {
@@ -239,6 +241,8 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
       actors.push_back(ros2::decode_actor_array(m.data, t));
     else if (t == topics::tf_static)
       tf_static = ros2::decode_tf(m.data, t);
+    else if (t == topics::truth_body)
+      bodies.push_back(ros2::decode_pose_stamped(m.data, t));
     else if (t == topics::tf)
       ++tf;
     else
@@ -250,6 +254,14 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
     const auto &a = truth[i], &b = run.truth[i];
     EXPECT_TRUE(a.stamp_ns == b.stamp_ns && a.pose.x == b.pose.x && a.pose.y == b.pose.y && a.pose.yaw == b.pose.yaw &&
                 a.speed == b.speed && a.yaw_rate == b.yaw_rate && a.steer == b.steer && a.cross_track == b.cross_track);
+  }
+  ASSERT_EQ(bodies.size(), run.truth.size());
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const Eigen::Isometry3d want = run.truth[i].body.pose();
+    EXPECT_EQ(bodies[i].stamp_ns, run.truth[i].stamp_ns);
+    EXPECT_EQ(bodies[i].parent, topics::vehicle_frame);
+    EXPECT_TRUE(bodies[i].translation == want.translation());
+    EXPECT_TRUE(bodies[i].rotation.coeffs() == Eigen::Quaterniond(want.rotation()).coeffs());
   }
   ASSERT_EQ(can.size(), run.can.size());
   for (size_t i = 0; i < can.size(); ++i)

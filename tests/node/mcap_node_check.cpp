@@ -49,6 +49,7 @@ int compare(const std::string& mcap, const std::string& json_path) {
   const std::map<std::string, size_t> written = {{t::tf_static, 1},
                                                  {t::vehicle_report, run.can.size()},
                                                  {t::truth_state, run.truth.size()},
+                                                 {t::truth_body, run.truth.size()},
                                                  {t::truth_odometry, run.truth.size()},
                                                  {t::tf, run.truth.size() + run.estimates.size()},
                                                  {t::gps_fix, run.gps.size()},
