@@ -101,9 +101,12 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
   header.tile_cells = o.tile_cells;
   IntensityMapBuilder builder(header);
 
-  Hdl32eConfig lidar;
+  // The survey unit, of its own serial, calibrated in situ by the surveyors (no range biases or
+  // intensity offsets left, no mixed returns or dropouts modelled), on a dry day: the map is the same
+  // whatever the scenario's realism profile and weather.
+  Hdl32eConfig lidar = hdl32e_config_for(Realism::ideal);
   lidar.unit_serial = o.survey_unit_serial;
-  const LidarScanner scanner(lidar, materials);
+  const LidarScanner scanner(lidar, materials, weather_config_for(Realism::ideal));
   const Eigen::Isometry3d mount = lidar.mount();
   const GroundHeight pavement = world.pavement();
   const VehicleParams survey_car;

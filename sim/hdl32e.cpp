@@ -29,6 +29,29 @@ Eigen::Isometry3d Hdl32eConfig::mount() const {
   return m;
 }
 
+Hdl32eConfig hdl32e_config_for(Realism realism) {
+  Hdl32eConfig c;
+  switch (realism) {
+    case Realism::ideal:
+      c.laser_range_bias_sigma_m = 0;
+      c.laser_intensity_offset_sigma = 0;
+      c.dropout_probability = 0;
+      c.mixed_returns = false;
+      break;
+    case Realism::typical:
+      break;
+    case Realism::harsh:
+      // A poorly calibrated unit: assumptions, about three times the typical spreads (Blensor's
+      // default per-laser range bias sigma, 7.8 cm, is larger still).
+      c.laser_range_bias_sigma_m = 0.03;
+      c.laser_intensity_offset_sigma = 5.0;
+      c.laser_gain_spread = 0.15;
+      c.dropout_probability = 0.01;
+      break;
+  }
+  return c;
+}
+
 void read_hdl32e_config(const YamlReader& y, const YAML::Node& n, Hdl32eConfig& c) {
   YamlMap m(y, n, "lidar");
   if (const YAML::Node e = m["elevation_deg"]) {
@@ -63,6 +86,13 @@ void read_hdl32e_config(const YamlReader& y, const YAML::Node& n, Hdl32eConfig& 
       .number("intensity_noise", c.intensity_noise, 0.0, 50.0)
       .number("laser_gain_spread", c.laser_gain_spread, 0.0, 0.5)
       .integer("unit_serial", c.unit_serial, 0, uint64_t(1) << 40)
+      .number("laser_range_bias_sigma_m", c.laser_range_bias_sigma_m, 0.0, 0.5)
+      .number("laser_intensity_offset_sigma", c.laser_intensity_offset_sigma, 0.0, 50.0)
+      .number("dropout_probability", c.dropout_probability, 0.0, 1.0)
+      .boolean("mixed_returns", c.mixed_returns)
+      .number("beam_divergence_mrad", c.beam_divergence_mrad, 0.0, 50.0)
+      .number("mixed_edge_step_m", c.mixed_edge_step_m, 0.001, 10.0)
+      .number("pulse_length_m", c.pulse_length_m, 0.0, 10.0)
       .vec3("mount_xyz", c.mount_xyz)
       .vec3("mount_rpy_deg", c.mount_rpy_deg)
       .boolean("motion_distortion", c.motion_distortion)

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "common/yaml_reader.hpp"
+#include "sim/realism.hpp"
 
 namespace lidarloop {
 
@@ -44,6 +45,37 @@ struct Hdl32eConfig {
   double laser_gain_spread = 0.08;  // per-laser gains uniform in 1 +- spread, fixed by the unit's serial
   uint64_t unit_serial = 1;
 
+  // Per-laser faults left after the factory calibration, fixed by the unit's serial like the gains
+  // (each laser draws once from a zero-mean normal of this sigma). A range bias shifts every range of
+  // a laser; an intensity offset adds counts to every diffuse return of a laser.
+  // Range bias 1 cm: assumption, within the datasheet's accuracy (<2 cm) and of the size that in-situ
+  // recalibration removes (Chen & Chien 2012, HDL-64E: factory parameters leave layered ring
+  // misalignment; recalibration cut planar RMS error by up to 49 %).
+  double laser_range_bias_sigma_m = 0.01;
+  // Intensity offset 2 counts: assumption (the HDL-64E's calibration table carries per-laser intensity
+  // corrections, Velodyne HDL-64E S3 manual; Levinson & Thrun 2010 calibrate per-beam remittance; the
+  // HDL-32E ships none, so some spread remains).
+  double laser_intensity_offset_sigma = 2.0;
+  // Random dropouts: a firing returns nothing with this probability, whatever it hit. Most real ray
+  // drop is dark or grazing surfaces (the detection model above); this is the remainder, 0.1 %:
+  // assumption.
+  double dropout_probability = 0.001;
+
+  // Mixed returns at depth edges. The beam is not a line: its spot is a rectangle about 4 in wide by
+  // 2 in tall at 100 ft (HDL-32E user manual, appendix D), 3.3 mrad horizontal divergence, wider than
+  // the 2.9 mrad between a laser's firings at 10 Hz. Where the range jumps between two neighbouring
+  // firings of a laser (a depth edge: the jump differs from the range trend on both sides by more than
+  // mixed_edge_step_m), the spot may straddle both surfaces; the edge lies uniformly between the two
+  // beam centres, the spot's fraction beyond it is the other surface's share, and when the two echoes
+  // overlap in time (range difference below pulse_length_m) the sensor reports one range between
+  // them, weighted by each surface's share of the received power.
+  bool mixed_returns = true;
+  double beam_divergence_mrad = 3.33;  // horizontal, full width (manual: 4 in at 100 ft)
+  double mixed_edge_step_m = 0.05;     // assumption: below this a mix hides in the 2 cm range noise
+  // 4 ns pulses (Velodyne, HDL-64E principles of operation; assumed the same for the HDL-32E) are
+  // c * 4 ns / 2 = 0.6 m long in range: echoes farther apart than that are resolved, not merged.
+  double pulse_length_m = 0.6;
+
   // Sensor pose in the vehicle frame (origin at the rear axle centre on the ground).
   Eigen::Vector3d mount_xyz{1.2, 0.0, 1.9};
   Eigen::Vector3d mount_rpy_deg{0.0, 0.0, 0.0};
@@ -62,6 +94,11 @@ struct Hdl32eConfig {
   static std::array<double, kHdl32eLasers> default_elevations();
   static std::array<int, kHdl32eLasers> default_firing_order();
 };
+
+// The sensor of a realism profile: typical = the defaults above (a factory-calibrated unit); ideal =
+// no range biases, no intensity offsets, no random dropouts, no mixed returns (the sensor as it was
+// before these faults were modelled); harsh = a poorly calibrated unit.
+Hdl32eConfig hdl32e_config_for(Realism realism);
 
 // Applies the overrides in a YAML mapping (keys as the field names) and validates the result.
 void read_hdl32e_config(const YamlReader& yaml, const YAML::Node& node, Hdl32eConfig& config);

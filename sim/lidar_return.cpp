@@ -24,8 +24,19 @@ ReturnModel::ReturnModel(const Hdl32eConfig& config)
       sure_hit_(std::exp(20.7 * config.detection_softness)) {
   // Per-laser gains are a property of the unit, like a real sensor's calibration table.
   const CounterRng unit(config.unit_serial, 0x6761696eULL);
-  for (int ring = 0; ring < kHdl32eLasers; ++ring)
+  // Range biases and intensity offsets come from streams of their own, so the gains stay those of
+  // the same serial before these faults were modelled.
+  const CounterRng biases(config.unit_serial, 0x72626961ULL), offsets(config.unit_serial, 0x696f6666ULL);
+  for (int ring = 0; ring < kHdl32eLasers; ++ring) {
     gain_[ring] = 1.0 + config.laser_gain_spread * (2.0 * unit.uniform(uint64_t(ring)) - 1.0);
+    range_bias_[ring] = config.laser_range_bias_sigma_m * biases.normal(uint64_t(ring));
+    intensity_offset_[ring] = config.laser_intensity_offset_sigma * offsets.normal(uint64_t(ring));
+  }
+}
+
+double ReturnModel::signal(const Material& material, double range, double cos_incidence) const {
+  const double reflectivity = material.retro ? 100.0 * material.reflectivity : material.reflectivity;
+  return reflectivity * power(cos_incidence, c_.detection_incidence_exponent) / (range * range);
 }
 
 std::optional<LidarReturn> ReturnModel::operator()(const Material& material, double range, double cos_incidence,
@@ -43,13 +54,14 @@ std::optional<LidarReturn> ReturnModel::operator()(const Material& material, dou
     if (rng.uniform(3 * k) >= p_detect) return std::nullopt;
   }
 
-  double measured = range + c_.range_noise_m * rng.normal(3 * k + 1);
+  // The laser's range bias is part of what it measures: the quantisation and range limits apply after it.
+  double measured = range + range_bias_[ring] + c_.range_noise_m * rng.normal(3 * k + 1);
   if (c_.range_resolution_m > 0) measured = std::round(measured / c_.range_resolution_m) * c_.range_resolution_m;
   if (measured < c_.min_range_m || measured > c_.max_range_m) return std::nullopt;
 
   const double falloff = power(std::min(1.0, c_.intensity_reference_range_m / range), c_.intensity_range_exponent);
   const double response = power(cos_incidence, c_.intensity_incidence_exponent) * gain_[ring] * falloff;
-  const double noise = c_.intensity_noise * rng.normal(3 * k + 2);
+  const double noise = c_.intensity_noise * rng.normal(3 * k + 2) + intensity_offset_[ring];
   double intensity = material.retro ? 101.0 + 154.0 * material.reflectivity * response + noise
                                     : 100.0 * material.reflectivity * response + noise;
   intensity = material.retro ? std::clamp(intensity, 101.0, 255.0) : std::clamp(intensity, 0.0, 100.0);

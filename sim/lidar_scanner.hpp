@@ -9,6 +9,12 @@
 //
 // Output order is firing order, and each ray's noise comes from a counter-based generator keyed by the
 // scan and the ray's index, so the cloud is identical whatever the number of threads.
+//
+// The sensor's own faults (sim/hdl32e.hpp): per-laser range biases and intensity offsets (in the
+// return model), random dropouts, and mixed returns at depth edges, found after casting by comparing
+// each firing with the same laser's previous and next firing (no extra rays). The weather
+// (sim/weather.hpp): a wet road darkens road and marking materials, puddles on the carriageway return
+// nothing, rain drops and the spray behind moving actors give spurious returns short of the surface.
 #include <functional>
 #include <vector>
 
@@ -19,6 +25,7 @@
 #include "sim/lidar_return.hpp"
 #include "sim/materials.hpp"
 #include "sim/ray_scene.hpp"
+#include "sim/weather.hpp"
 
 namespace lidarloop {
 
@@ -34,9 +41,10 @@ using LidarRay = Ray;
 
 class LidarScanner {
  public:
-  LidarScanner(const Hdl32eConfig& config, const MaterialTable& materials);
+  LidarScanner(const Hdl32eConfig& config, const MaterialTable& materials, const WeatherConfig& weather = {});
 
   const Hdl32eConfig& config() const { return config_; }
+  const WeatherConfig& weather() const { return weather_; }
 
   PointCloud scan(RayScene& scene, const PoseAt& vehicle_pose, int64_t stamp_ns, uint64_t seed,
                   const ActorPoses& actor_poses = {}) const;
@@ -53,9 +61,22 @@ class LidarScanner {
   std::vector<CyclePose> cycle_poses(const PoseAt& vehicle_pose, int64_t stamp_ns) const;
   Eigen::Vector3f sensor_direction(int cycle, int slot) const;
   LidarRay ray(const CyclePose& pose, int cycle, int slot) const;
+  // Where a beam's spot straddles a depth edge, moves its range towards the other surface's.
+  void mix_depth_edges(const std::vector<float>& surface_range, const std::vector<float>& surface_signal,
+                       const std::vector<uint8_t>& from_surface, const CounterRng& faults,
+                       std::vector<LidarPoint>& points) const;
+  // A volume of spray behind a moving actor over one keyframe interval: world -> box frame, where the
+  // box spans x in [-length, 0], |y| <= width / 2, z in [0, height]; density in returns per metre.
+  struct SprayBox {
+    Eigen::Isometry3f to_box;
+    float length, density;
+  };
+  std::vector<SprayBox> spray_boxes(const std::vector<std::vector<Eigen::Isometry3d>>& motion) const;
 
   Hdl32eConfig config_;
-  std::vector<Material> materials_;
+  WeatherConfig weather_;
+  std::vector<Material> materials_;   // as the weather makes them look (a wet road is darker)
+  std::vector<uint8_t> carriageway_;  // per material: road surface that puddles cover
   ReturnModel returns_;
   Eigen::Isometry3d mount_;
   // Per firing slot: the beam's unit vector at zero yaw, with the slot's own yaw advance folded in.

@@ -201,12 +201,15 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   }
   if (realism) s.realism = *realism;
   s.ego = read_ego(y, root.required("ego"), vehicle);
+  s.lidar = hdl32e_config_for(s.realism);
   if (const YAML::Node n = root["lidar"]) read_hdl32e_config(y, n, s.lidar);
   if (const YAML::Node n = root["can"]) read_can(y, n, s.can);
   if (const YAML::Node n = root["gps"]) read_gps(y, n, s.gps);
   if (const YAML::Node n = root["rtk"]) read_rtk(y, n, s.rtk);
   s.body = body_config_for(s.realism);
   read_body_config(y, root["body"], s.body);
+  s.weather = weather_config_for(s.realism);
+  if (const YAML::Node n = root["weather"]) read_weather_config(y, n, s.weather);
   if (const YAML::Node t = root["traffic"]) {
     y.expect_sequence(t, "traffic");
     for (const auto& a : t) s.traffic.push_back(read_actor(y, a));

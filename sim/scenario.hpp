@@ -16,6 +16,7 @@
 #include "sim/traffic.hpp"
 #include "sim/vehicle_body.hpp"
 #include "sim/vehicle_model.hpp"
+#include "sim/weather.hpp"
 #include "sim/world_builder.hpp"
 
 namespace lidarloop {
@@ -85,6 +86,7 @@ struct Scenario {
   GpsConfig gps;
   RtkConfig rtk;
   BodyConfig body;  // the ego's suspension (`body`)
+  WeatherConfig weather;  // the day the scenario is driven on (the map was surveyed on a dry one)
   std::vector<TrafficSpec> traffic;
   // `localizer`: the method here; the rest of the section (parameter overrides) belongs to the
   // localizer and is read by the tools from `text`, since sim/ does not know the localizer.

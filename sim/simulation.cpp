@@ -28,7 +28,7 @@ Simulation::Simulation(const Scenario& scenario, const WorldDescription& descrip
     : scenario_(scenario),
       resolved_(resolve_scenario(scenario, description, world)),
       scene_(std::make_unique<RayScene>(world.mesh, threads)),
-      scanner_(scenario.lidar, materials),
+      scanner_(scenario.lidar, materials, scenario.weather),
       vehicle_(scenario.ego.vehicle,
                VehicleModel::state_at(scenario.ego.vehicle, resolved_.ego_route.pose_at(scenario.ego.start_at),
                                       scenario.ego.initial_speed)),

@@ -29,7 +29,7 @@ World world_from_yaml(const std::string& yaml, const std::string& name) {
 }
 
 Hdl32eConfig noiseless_hdl32e() {
-  Hdl32eConfig c;
+  Hdl32eConfig c = hdl32e_config_for(Realism::ideal);  // no per-laser biases, dropouts or mixed returns
   c.range_noise_m = 0;
   c.intensity_noise = 0;
   c.detection_softness = 0;
