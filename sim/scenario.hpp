@@ -8,11 +8,13 @@
 #include <vector>
 
 #include "sim/can_model.hpp"
+#include "sim/clocks.hpp"
 #include "sim/controller.hpp"
 #include "sim/gps_model.hpp"
 #include "sim/hdl32e.hpp"
 #include "sim/path.hpp"
 #include "sim/realism.hpp"
+#include "sim/sensor_calibration.hpp"
 #include "sim/traffic.hpp"
 #include "sim/vehicle_model.hpp"
 #include "sim/world_builder.hpp"
@@ -83,6 +85,8 @@ struct Scenario {
   CanConfig can;
   GpsConfig gps;
   RtkConfig rtk;
+  MountErrorConfig mount_error;  // the true LiDAR mount and GPS antenna against the nominal `lidar` / `gps` ones
+  ClockConfig clocks;            // the LiDAR's and the CAN's stamping clocks against the reference
   std::vector<TrafficSpec> traffic;
   // `localizer`: the method here; the rest of the section (parameter overrides) belongs to the
   // localizer and is read by the tools from `text`, since sim/ does not know the localizer.
