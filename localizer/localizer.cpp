@@ -211,7 +211,11 @@ void Localizer::on_gps(const GpsFix& fix) {
   if (fix.status == GpsStatus::no_fix) return;
   if (!std::isfinite(fix.lat_deg) || !std::isfinite(fix.lon_deg) || !std::isfinite(fix.heading_rad)) return;
   predict_to(fix.stamp_ns);
-  const Eigen::Vector2d p = frame_.to_local(fix.lat_deg, fix.lon_deg);
+  // The fix is the antenna's; the rear axle is the lever arm behind it, turned by the heading (the
+  // filter's when it has one: the receiver's heading is the worse by far).
+  const double heading = filter_ ? filter_->pose().yaw : fix.heading_rad;
+  const Eigen::Vector2d p =
+      frame_.to_local(fix.lat_deg, fix.lon_deg) - Eigen::Rotation2Dd(heading) * params_.gps_antenna.head<2>();
   const GpsNoise& n = params_.gps_noise;
   auto variance = [&](double reported, double floor) {
     return std::isfinite(reported) ? std::max(reported, floor * floor) : floor * floor;

@@ -60,6 +60,9 @@ struct LocalizerParams {
   // The LiDAR's pose in the vehicle frame (the extrinsic calibration). Not in YAML: it comes with the
   // sensor data (scenario's lidar section, a log's transforms).
   Eigen::Isometry3d lidar_mount = Eigen::Isometry3d::Identity();
+  // The GPS antenna in the vehicle frame (the lever arm from the rear axle), as the car's configuration
+  // gives it: a fix is the antenna's position, and KF1 estimates the rear axle's. Not in YAML either.
+  Eigen::Vector3d gps_antenna = Eigen::Vector3d::Zero();
   uint64_t seed = 1;                    // probabilistic ICP's draws
   double map_window_m = 32;             // curbs of the map within this half size are matched against
   double max_prediction_step_s = 0.01;  // Eq. 19 is integrated in steps no longer than this

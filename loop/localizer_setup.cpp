@@ -43,7 +43,9 @@ LocalizerParams localizer_params_for(const Scenario& s, const std::optional<std:
   p.vehicle.mass = v.mass;
   p.vehicle.steering_ratio = v.steering_ratio;
   p.vehicle.kinematic_below = v.kinematic_below;
+  // The nominal extrinsics (the car's configuration), never the true ones the simulation draws.
   p.lidar_mount = s.lidar.mount();
+  p.gps_antenna = s.gps.antenna_xyz;
   p.seed = s.seed;
   if (!s.text.empty()) {
     const YamlReader y = YamlReader::from_string(s.text, s.file);

@@ -8,6 +8,7 @@ namespace lidarloop {
 namespace {
 
 constexpr double kNanosecondsPerSecond = 1e9;
+constexpr uint64_t kClockStream = 0x63616e636c6f636b;  // "canclock": the stamping clock's jitter
 
 // Rounds to the nearest multiple of `resolution`, as the ECU's integer encoding does (the factor
 // in assets/vehicle_can.dbc); a resolution of 0 means the value is not quantised.
@@ -21,7 +22,8 @@ void require(bool ok, const std::string& what) {
 
 }  // namespace
 
-CanModel::CanModel(const CanConfig& config, uint64_t seed) : config_(config), rng_(seed) {
+CanModel::CanModel(const CanConfig& config, uint64_t seed, const StampClock& clock)
+    : config_(config), rng_(seed), clock_(clock), clock_rng_(seed, kClockStream) {
   require(std::isfinite(config.rate_hz) && config.rate_hz > 0, "rate_hz must be positive");
   require(config.wheel_speed_resolution_mps >= 0 && config.steering_resolution_rad >= 0,
           "resolutions must not be negative");
@@ -29,12 +31,13 @@ CanModel::CanModel(const CanConfig& config, uint64_t seed) : config_(config), rn
   require(config.wheel_speed_scale_error > -1, "wheel_speed_scale_error must be > -1");
   require(config.latency_ns >= 0, "latency must not be negative");
   require(config.dropout_probability >= 0 && config.dropout_probability < 1, "dropout_probability must be in [0, 1)");
+  require(clock.jitter_ns >= 0, "clock jitter must not be negative");
 }
 
 void CanModel::measure(int64_t t_ns, const std::array<double, 4>& wheel_speeds_mps, double steering_wheel_angle_rad) {
-  const int64_t stamp = t_ns + config_.latency_ns;
+  const int64_t arrival = t_ns + config_.latency_ns;
   // One constant latency keeps the FIFO sorted by arrival only if measurements come in time order.
-  if (!in_flight_.empty() && stamp < in_flight_.back().stamp_ns)
+  if (!in_flight_.empty() && arrival < in_flight_.back().arrival_ns)
     throw std::logic_error("CanModel::measure called with a time earlier than the previous one");
 
   // Every call draws, in this order: the dropout uniform, four wheel-speed normals (FL, FR, RL, RR),
@@ -42,7 +45,8 @@ void CanModel::measure(int64_t t_ns, const std::array<double, 4>& wheel_speeds_m
   // on the seed and k: a run with dropouts delivers exactly the values of the same run without them.
   const bool dropped = uniform_(rng_) < config_.dropout_probability;
   CanFrame frame;
-  frame.stamp_ns = stamp;
+  // The host's stamp; jitter may put it before the previous frame's (a consumer sees it out of order).
+  frame.stamp_ns = stamp_on(clock_, arrival, clock_rng_, frame_index_++);
   for (size_t i = 0; i < wheel_speeds_mps.size(); ++i) {
     // A wheel-speed sensor counts tooth pulses: it reports a magnitude, whatever the direction.
     const double scaled = std::abs(wheel_speeds_mps[i]) * (1.0 + config_.wheel_speed_scale_error);
@@ -55,13 +59,13 @@ void CanModel::measure(int64_t t_ns, const std::array<double, 4>& wheel_speeds_m
   frame.steering_wheel_angle_rad =
       quantise(steering_wheel_angle_rad + config_.steering_offset_rad + config_.steering_noise_rad * normal_(rng_),
                config_.steering_resolution_rad);
-  if (!dropped) in_flight_.push_back(frame);
+  if (!dropped) in_flight_.push_back({arrival, frame});
 }
 
 std::vector<CanFrame> CanModel::deliver(int64_t now_ns) {
   std::vector<CanFrame> arrived;
-  while (!in_flight_.empty() && in_flight_.front().stamp_ns <= now_ns) {
-    arrived.push_back(in_flight_.front());
+  while (!in_flight_.empty() && in_flight_.front().arrival_ns <= now_ns) {
+    arrived.push_back(in_flight_.front().frame);
     in_flight_.pop_front();
   }
   return arrived;

@@ -1,7 +1,8 @@
 #pragma once
 // The vehicle's CAN bus: wheel speeds and steering-wheel angle as a production car reports them
 // (frame layout in assets/vehicle_can.dbc): quantised, noisy, with a scale-factor error (tyre radius),
-// a steering offset, bus latency and dropped frames.
+// a steering offset, bus latency and dropped frames. The host stamps a frame on arrival with its own
+// clock (sim/clocks.hpp): the stamp is the arrival time plus that clock's offset and jitter.
 #include <array>
 #include <cstdint>
 #include <deque>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "common/vehicle_messages.hpp"
+#include "sim/clocks.hpp"
 
 namespace lidarloop {
 
@@ -27,9 +29,10 @@ struct CanConfig {
 
 class CanModel {
  public:
-  CanModel(const CanConfig& config, uint64_t seed);
+  // `clock`: the host clock that stamps the frames (default: the reference clock itself).
+  CanModel(const CanConfig& config, uint64_t seed, const StampClock& clock = {});
   // Measures the truth at time t (call at the configured rate, in increasing time); the frame
-  // arrives latency_ns later unless dropped.
+  // arrives latency_ns later unless dropped, stamped by the clock.
   void measure(int64_t t_ns, const std::array<double, 4>& wheel_speeds_mps, double steering_wheel_angle_rad);
   // Frames that have arrived by `now`, oldest first; each is returned once.
   std::vector<CanFrame> deliver(int64_t now_ns);
@@ -40,7 +43,14 @@ class CanModel {
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
   std::uniform_real_distribution<double> uniform_{0.0, 1.0};
-  std::deque<CanFrame> in_flight_;
+  StampClock clock_;
+  CounterRng clock_rng_;  // the clock's jitter, by frame index: apart from the noise draws above
+  uint64_t frame_index_ = 0;
+  struct InFlight {
+    int64_t arrival_ns;  // reference clock
+    CanFrame frame;      // stamped by the host clock
+  };
+  std::deque<InFlight> in_flight_;
 };
 
 }  // namespace lidarloop

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/Geometry>
+
 namespace lidarloop {
 namespace {
 
@@ -39,6 +41,12 @@ bool zone_applies(const GpsZone& zone, int64_t t_ns, const Pose2d& truth) {
 
 }  // namespace
 
+GpsConfig gps_config_for(Realism realism) {
+  GpsConfig c;
+  if (realism == Realism::ideal) c.antenna_xyz.setZero();
+  return c;
+}
+
 GpsModel::GpsModel(const GpsConfig& config, const LocalFrame& frame, uint64_t seed)
     : config_(config), frame_(frame), rng_(seed) {
   require(finite_positive(config.rate_hz), "GPS config: rate_hz must be positive");
@@ -52,6 +60,7 @@ GpsModel::GpsModel(const GpsConfig& config, const LocalFrame& frame, uint64_t se
     require(finite_non_negative(zone.radius_m), "GPS zone: radius must not be negative");
     require(zone.centre.allFinite() && zone.jump_m.allFinite(), "GPS zone: centre and jump must be finite");
   }
+  require(config.antenna_xyz.allFinite(), "GPS config: antenna_xyz must be finite");
 }
 
 GpsFix GpsModel::sample(int64_t t_ns, const Pose2d& truth) {
@@ -101,8 +110,11 @@ GpsFix GpsModel::sample(int64_t t_ns, const Pose2d& truth) {
   }
 
   const Eigen::Vector2d white = config_.white_sigma_m * Eigen::Vector2d(n_white_e, n_white_n);
-  const Eigen::Vector2d measured = Eigen::Vector2d(truth.x, truth.y) + bias_ + white + jump;
-  const Geodetic g = frame_.to_geodetic(measured, frame_.origin().alt_m + config_.vertical_sigma_m * n_white_u);
+  const Eigen::Vector2d antenna =
+      Eigen::Vector2d(truth.x, truth.y) + Eigen::Rotation2Dd(truth.yaw) * config_.antenna_xyz.head<2>();
+  const Eigen::Vector2d measured = antenna + bias_ + white + jump;
+  const Geodetic g = frame_.to_geodetic(
+      measured, frame_.origin().alt_m + config_.antenna_xyz.z() + config_.vertical_sigma_m * n_white_u);
   fix.status = GpsStatus::fix;
   fix.lat_deg = g.lat_deg;
   fix.lon_deg = g.lon_deg;

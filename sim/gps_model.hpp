@@ -6,6 +6,9 @@
 // the exact discretisation  b <- e^{-dt/tau} b + sigma sqrt(1 - e^{-2 dt/tau}) n,  so its stationary
 // standard deviation is sigma and its correlation time tau at any sample rate. Heading error is the
 // same kind of process. Zones (in space or time) make the receiver lose its fix or jump (multipath).
+// The fix is the antenna's position, `antenna_xyz` from the rear axle in the vehicle frame (the lever
+// arm); the localizer is told the nominal lever arm and takes it off (sim/sensor_calibration.hpp draws
+// how far the true antenna is from the nominal).
 #include <cstdint>
 #include <optional>
 #include <random>
@@ -16,6 +19,7 @@
 
 #include "common/geodetic.hpp"
 #include "common/vehicle_messages.hpp"
+#include "sim/realism.hpp"
 
 namespace lidarloop {
 
@@ -38,14 +42,21 @@ struct GpsConfig {
   double heading_bias_sigma_rad = 0.026;  // ~1.5 deg
   double heading_bias_tau_s = 60.0;
   double heading_white_sigma_rad = 0.017;
+  // The antenna in the vehicle frame (x forward, y left, z up from the rear axle centre on the ground):
+  // on the roof's centre line, 0.9 m ahead of the rear axle, 1.5 m up (assumption: a sedan's roof,
+  // behind the LiDAR at 1.2 m). ideal: at the rear axle (no lever arm).
+  Eigen::Vector3d antenna_xyz{0.9, 0.0, 1.5};
   std::vector<GpsZone> zones;
 };
+// ideal: the antenna at the rear axle; typical and harsh: the defaults (the noise figures are the
+// paper's receiver under every profile).
+GpsConfig gps_config_for(Realism realism);
 
 class GpsModel {
  public:
   GpsModel(const GpsConfig& config, const LocalFrame& frame, uint64_t seed);
-  // A fix of the antenna at `truth` at time t (call in increasing time at the configured rate);
-  // status no_fix inside an outage zone (and no position then).
+  // A fix of the antenna on a car whose rear axle is at `truth` at time t (call in increasing time at the configured
+  // rate); status no_fix inside an outage zone (and no position then).
   GpsFix sample(int64_t t_ns, const Pose2d& truth);
   int64_t period_ns() const;
 

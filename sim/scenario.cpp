@@ -118,7 +118,8 @@ void read_gps(const YamlReader& y, const YAML::Node& n, GpsConfig& g) {
       .number("vertical_sigma_m", g.vertical_sigma_m, 0.0, 100.0)
       .degrees("heading_bias_sigma_deg", g.heading_bias_sigma_rad, 0.0, 90.0)
       .number("heading_bias_tau_s", g.heading_bias_tau_s, 0.1, 1e5)
-      .degrees("heading_white_sigma_deg", g.heading_white_sigma_rad, 0.0, 90.0);
+      .degrees("heading_white_sigma_deg", g.heading_white_sigma_rad, 0.0, 90.0)
+      .vec3("antenna_xyz", g.antenna_xyz);
   if (const YAML::Node zones = m["zones"]) {
     y.expect_sequence(zones, "zones");
     for (const auto& z : zones) g.zones.push_back(read_gps_zone(y, z));
@@ -204,12 +205,17 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   s.lidar = hdl32e_config_for(s.realism);
   if (const YAML::Node n = root["lidar"]) read_hdl32e_config(y, n, s.lidar);
   if (const YAML::Node n = root["can"]) read_can(y, n, s.can);
+  s.gps = gps_config_for(s.realism);
   if (const YAML::Node n = root["gps"]) read_gps(y, n, s.gps);
   if (const YAML::Node n = root["rtk"]) read_rtk(y, n, s.rtk);
   s.body = body_config_for(s.realism);
   read_body_config(y, root["body"], s.body);
   s.weather = weather_config_for(s.realism);
   if (const YAML::Node n = root["weather"]) read_weather_config(y, n, s.weather);
+  s.mount_error = mount_error_config_for(s.realism);
+  read_mount_error(y, root["mount_error"], s.mount_error);
+  s.clocks = clock_config_for(s.realism);
+  read_clocks(y, root["clocks"], s.clocks);
   if (const YAML::Node t = root["traffic"]) {
     y.expect_sequence(t, "traffic");
     for (const auto& a : t) s.traffic.push_back(read_actor(y, a));

@@ -8,11 +8,13 @@
 #include <vector>
 
 #include "sim/can_model.hpp"
+#include "sim/clocks.hpp"
 #include "sim/controller.hpp"
 #include "sim/gps_model.hpp"
 #include "sim/hdl32e.hpp"
 #include "sim/path.hpp"
 #include "sim/realism.hpp"
+#include "sim/sensor_calibration.hpp"
 #include "sim/traffic.hpp"
 #include "sim/vehicle_body.hpp"
 #include "sim/vehicle_model.hpp"
@@ -87,6 +89,8 @@ struct Scenario {
   RtkConfig rtk;
   BodyConfig body;  // the ego's suspension (`body`)
   WeatherConfig weather;  // the day the scenario is driven on (the map was surveyed on a dry one)
+  MountErrorConfig mount_error;  // the true LiDAR mount and GPS antenna against the nominal `lidar` / `gps` ones
+  ClockConfig clocks;            // the LiDAR's and the CAN's stamping clocks against the reference
   std::vector<TrafficSpec> traffic;
   // `localizer`: the method here; the rest of the section (parameter overrides) belongs to the
   // localizer and is read by the tools from `text`, since sim/ does not know the localizer.

@@ -11,6 +11,7 @@ constexpr int64_t kControlPeriodNs = 10'000'000;  // the driver acts at 100 Hz
 constexpr int64_t kTruthPeriodNs = 10'000'000;    // ground truth recorded at 100 Hz
 // Seeds of the sensors' random streams, derived from the scenario seed so each is independent.
 constexpr uint64_t kCanStream = 1, kGpsStream = 2, kRtkStream = 3, kLidarStream = 4;
+constexpr uint64_t kLidarClockStream = 0x6c6964636c6f636b;  // "lidclock"
 
 namespace {
 
@@ -28,14 +29,18 @@ Simulation::Simulation(const Scenario& scenario, const WorldDescription& descrip
     : scenario_(scenario),
       resolved_(resolve_scenario(scenario, description, world)),
       scene_(std::make_unique<RayScene>(world.mesh, threads)),
-      scanner_(scenario.lidar, materials, scenario.weather),
+      mount_draw_(draw_mount_error(scenario.mount_error, scenario.seed)),
+      true_lidar_mount_(with_true_mount(scenario.lidar, mount_draw_).mount()),
+      lidar_clock_rng_(scenario.seed, kLidarClockStream),
+      scanner_(with_true_mount(scenario.lidar, mount_draw_), materials, scenario.weather),
       vehicle_(scenario.ego.vehicle,
                VehicleModel::state_at(scenario.ego.vehicle, resolved_.ego_route.pose_at(scenario.ego.start_at),
                                       scenario.ego.initial_speed)),
       controller_(resolved_.ego_route, scenario.ego.speed, scenario.ego.stops, scenario.ego.vehicle,
                   scenario.ego.controller),
-      can_(scenario.can, mix64(scenario.seed ^ kCanStream)),
-      gps_(scenario.gps, LocalFrame(description.origin), mix64(scenario.seed ^ kGpsStream)),
+      can_(scenario.can, mix64(scenario.seed ^ kCanStream), scenario.clocks.can),
+      gps_(with_true_antenna(scenario.gps, mount_draw_), LocalFrame(description.origin),
+           mix64(scenario.seed ^ kGpsStream)),
       rtk_(scenario.rtk, LocalFrame(description.origin), mix64(scenario.seed ^ kRtkStream)),
       control_period_ns_(kControlPeriodNs),
       ground_(world.ground()),
@@ -120,9 +125,10 @@ void Simulation::emit_scan(StreamSink& sink) {
     body.roll += f * (bodies[i + 1].roll - body.roll);
     return Eigen::Isometry3d(ground * body.pose());
   };
-  const PointCloud cloud =
-      scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses_);
-  sink.on_scan(cloud, vehicle_pose(stamp) * scenario_.lidar.mount());
+  PointCloud cloud = scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses_);
+  // The LiDAR's clock stamps the scan; the truth (sensor pose, actors) stays on the reference clock.
+  cloud.stamp_ns = stamp_on(scenario_.clocks.lidar, stamp, lidar_clock_rng_, uint64_t(scan_index_));
+  sink.on_scan(cloud, vehicle_pose(stamp) * true_lidar_mount_);
   std::vector<ActorSample> states;
   for (const auto& a : resolved_.actors) states.push_back({a.name, a.type, actor_pose2d(a, stamp)});
   sink.on_actors(stamp, states);

@@ -27,7 +27,8 @@ class StreamSink {
   virtual void on_can(const CanFrame&) {}
   virtual void on_gps(const GpsFix&) {}
   virtual void on_rtk(const GpsFix&) {}
-  // sensor_pose: the LiDAR's pose in the world at the scan's stamp.
+  // sensor_pose: the LiDAR's true pose in the world (true mount, sim/sensor_calibration.hpp) at the
+  // scan's first firing on the reference clock; the cloud's stamp is the LiDAR clock's (sim/clocks.hpp).
   virtual void on_scan(const PointCloud&, const Eigen::Isometry3d& /*sensor_pose*/) {}
   virtual void on_actors(int64_t /*stamp_ns*/, const std::vector<ActorSample>&) {}
 };
@@ -50,6 +51,8 @@ class Simulation {
   const ResolvedScenario& resolved() const { return resolved_; }
   const VehicleModel& vehicle() const { return vehicle_; }
   const VehicleBody& body() const { return body_; }
+  // This run's draw of the true sensor mounts against the nominal ones (the scenario's `mount_error`).
+  const MountDraw& mount_draw() const { return mount_draw_; }
 
  private:
   void step(StreamSink& sink);
@@ -58,6 +61,9 @@ class Simulation {
   Scenario scenario_;
   ResolvedScenario resolved_;
   std::unique_ptr<RayScene> scene_;
+  MountDraw mount_draw_;
+  Eigen::Isometry3d true_lidar_mount_;
+  CounterRng lidar_clock_rng_;  // the LiDAR clock's jitter, by scan index
   LidarScanner scanner_;
   VehicleModel vehicle_;
   PathController controller_;

@@ -30,6 +30,10 @@ constexpr float kConeHeight = 0.71f, kConeBaseRadius = 0.18f, kConeTopRadius = 0
 constexpr float kBandLow = 0.40f, kBandHigh = 0.55f, kBandRadiusLow = 0.105f, kBandRadiusHigh = 0.075f;  // m
 constexpr double kBarrierLength = 3.8, kBarrierJoint = 0.05;         // m; a barrier segment and half the gap between
 constexpr float kBarrierHeight = 0.81f, kBarrierHalfWidth = 0.305f;  // m
+// A construction zone's temporary kerb: precast blocks 1 m long and 0.3 m wide (assumption: the common
+// size of bolt-down kerb units), as high as the road's curb.
+constexpr double kKerbBlockLength = 1.0;
+constexpr float kKerbHalfWidth = 0.15f;
 
 // Roadside: a hydrant's barrel is this share of its height, its cap narrows to this share of its
 // radius; a verge lies a little above the raised ground, so the two do not fight for the same rays; a
@@ -523,6 +527,26 @@ struct Builder {
         const float base = float(world.surface->carriageway(p));
         add_box(world.mesh, p.cast<float>(), {float(kBarrierLength / 2 - kBarrierJoint), kBarrierHalfWidth},
                 float(std::atan2(at.tangent.y(), at.tangent.x())), base, base + kBarrierHeight, concrete);
+      }
+      if (zone.curb_shift > 0) {
+        // The temporary kerb: its road-side face is the new curb line, `curb_shift` in from the old one.
+        const double face = road.width / 2 - zone.curb_shift;
+        Polyline2d line;
+        for (double s = 0; s < length; s += kKerbBlockLength) {
+          const double mid = std::min(s + kKerbBlockLength / 2, length);
+          const PolylineSample at = sample_polyline(stretch, mid);
+          const Eigen::Vector2d p = at.point + left_normal(at.tangent) * side * (face + kKerbHalfWidth);
+          const float base = float(world.surface->carriageway(p));
+          add_box(world.mesh, p.cast<float>(), {float(kKerbBlockLength / 2), kKerbHalfWidth},
+                  float(std::atan2(at.tangent.y(), at.tangent.x())), base, base + float(road.curb_height), concrete);
+        }
+        for (double s = 0;; s = std::min(s + kKerbBlockLength, length)) {
+          const PolylineSample at = sample_polyline(stretch, s);
+          line.push_back(at.point + left_normal(at.tangent) * side * face);
+          if (s >= length) break;
+        }
+        world.curbs.push_back(line);
+        world.curb_kinds.push_back(curb_profile_name(CurbProfile::vertical));
       }
     }
     std::map<std::string, TriangleMesh> meshes;

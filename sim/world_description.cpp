@@ -13,7 +13,10 @@ namespace {
 
 constexpr double kMaxArcStep = 3.0 * kDeg;  // fillet arcs are split every 3 degrees
 constexpr double kMinSegment = 0.01;        // m; shorter centreline segments are input errors
-constexpr double kMaxTurn = 170.0 * kDeg;   // sharper turns between segments are a road doubling back
+// m between a construction zone's temporary kerb and a quarter of the road width (where its barriers
+// stand): a barrier's half width (0.305 m) and a kerb block's (0.15 m), rounded up.
+constexpr double kKerbClearance = 0.5;
+constexpr double kMaxTurn = 170.0 * kDeg;  // sharper turns between segments are a road doubling back
 
 MarkingStyle read_marking(const YamlReader& y, const YAML::Node& n) {
   const std::string s = y.string(n, "marking");
@@ -383,6 +386,12 @@ WorldDescription apply_world_changes(WorldDescription w, const YamlReader& y, co
     stretch(m, z.where, z.road, z.at, z.length);
     if (const YAML::Node side = m["side"]) z.side = read_side(y, side);
     if (z.side == RoadSide::both) y.fail(m["side"], "a construction zone closes one side: left or right");
+    m.boolean("curb_removed", z.curb_removed);
+    // The temporary kerb stays on the closed lanes' outer half, clear of the barriers down their middle.
+    const double max_shift = w.road(z.road)->width / 4 - kKerbClearance;
+    if (const YAML::Node shift = m["curb_shift"]) z.curb_shift = y.number_in(shift, "curb_shift", 0.0, max_shift);
+    if (z.curb_removed)  // no curb at all over the zone: a flush cut (CurbCut::flush)
+      w.curb_cuts.push_back({z.where, z.road, z.side, z.at, z.length, CurbCut::flush});
     return z;
   });
   root.done();

@@ -140,10 +140,15 @@ struct PaintChange {
   double at = 0, length = 20;  // centre (arc length along the centreline) and extent along the road, m
   double shift = 0;
 };
+// The zone may also have edited the closed side's curb since the survey: taken out (a flush cut over
+// the zone, `curb_removed`) and/or a temporary kerb of precast blocks set `curb_shift` metres into the
+// carriageway from the old curb line (a kerb extension narrowing the road); both together: the curb moved.
 struct ConstructionZone {
   std::string where, road;
   double at = 0, length = 30;
   RoadSide side = RoadSide::right;
+  bool curb_removed = false;
+  double curb_shift = 0;  // m; 0: no temporary kerb
 };
 
 struct WorldGeometryParams {

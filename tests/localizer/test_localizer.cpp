@@ -322,5 +322,47 @@ TEST(LocalizerParams, ReadsOverridesAndRejectsUnknownKeys) {
   EXPECT_THROW(read_localizer_params(method, method.root()["localizer"], p), InputError);
 }
 
+// A fix is the antenna's position. Driving straight at 60 deg with exact fixes of an antenna 1.5 m
+// ahead and 0.3 m left of the rear axle: configured with that lever arm, KF1's rear axle is the true
+// one to within 1 cm; configured without it, the estimate is off by the arm (the test can fail).
+TEST(LocalizerGps, TheConfiguredLeverArmIsTakenOffTheFixes) {
+  HdMap map = synthetic_map();
+  const LocalFrame frame(kOrigin);
+  const Eigen::Vector3d arm{1.5, 0.3, 1.6};
+  const double heading = 60 * M_PI / 180;
+  constexpr int64_t kDriveNs = 10'000'000'000;
+  auto final_error = [&](const Eigen::Vector3d& configured) {
+    LocalizerParams p = test_params();
+    p.method = LocalizerMethod::gps;
+    p.gps_antenna = configured;
+    Localizer localizer(map, p);
+    Eigen::Vector2d truth{0, 0};
+    for (int64_t t = 0; t <= kDriveNs; t += kCanNs) {
+      truth = kSpeed * double(t) * 1e-9 * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+      CanFrame f;
+      f.stamp_ns = t;
+      f.wheel_speed_mps = {kSpeed, kSpeed, kSpeed, kSpeed};
+      localizer.on_can(f);
+      if (t % kGpsNs != 0) continue;
+      GpsFix g;
+      g.stamp_ns = t;
+      g.status = GpsStatus::fix;
+      const Geodetic ll = frame.to_geodetic(truth + Eigen::Rotation2Dd(heading) * arm.head<2>());
+      g.lat_deg = ll.lat_deg, g.lon_deg = ll.lon_deg;
+      g.heading_rad = heading;
+      g.position_covariance[0] = g.position_covariance[4] = 4.0;
+      g.heading_variance = 0.03 * 0.03;
+      localizer.on_gps(g);
+    }
+    const Pose2d estimate = *localizer.pose();
+    return (Eigen::Vector2d(estimate.x, estimate.y) - truth).norm();
+  };
+  const double with_arm = final_error(arm), without = final_error(Eigen::Vector3d::Zero());
+  EXPECT_LT(with_arm, 0.01);
+  EXPECT_GT(without, 0.9 * arm.head<2>().norm());
+  RecordProperty("error_with_lever_arm_m", std::to_string(with_arm));
+  RecordProperty("error_without_m", std::to_string(without));
+}
+
 }  // namespace
 }  // namespace lidarloop

@@ -2,6 +2,7 @@
 // from the meshes by ray casts, from today's scans, and from the intensity layer of the survey.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -85,6 +86,41 @@ TEST(WorldChanges, AConstructionZoneStandsConesAndBarriersOnTheClosedSide) {
   EXPECT_LT(look_down(w, 8.0, 2.0).range, 0.05);  // the open lane is clear
 }
 
+// The zone's curb edits since the survey, on the closed (right) side from x = 8 to 32: a temporary
+// kerb 1 m into the road (its face at y = -3), and the old curb at y = -4 taken out (a flush cut). The
+// survey's world has neither; today's world has both, in its meshes and in its curb lines.
+TEST(WorldChanges, AConstructionZoneMovesTheClosedSidesCurb) {
+  const World then = build(surveyed());
+  const World now = build(
+      today("  construction: [{road: main, at: 20, length: 24, side: right, curb_removed: true, curb_shift: 1.0}]\n"));
+  const MaterialId concrete = test::materials().id("curb_concrete", "test");
+  // The kerb block behind the new face: as high as the road's curb (0.15 m), where the survey saw road.
+  EXPECT_LT(look_down(then, 20, -3.15).range, 0.02);
+  const RayHit kerb = look_down(now, 20, -3.15);
+  EXPECT_EQ(kerb.material, concrete);
+  EXPECT_NEAR(kerb.range, 0.15, 0.01);
+  EXPECT_LT(look_down(now, 5, -3.15).range, 0.02);  // before the zone: road as it was
+  // Curb lines: today a vertical one along y = -3 over the zone, and the old curb flush over the zone.
+  auto along = [](const World& w, double y, const std::string& kind) {
+    double covered = 0;  // m of x in [8, 32] that a line of this kind runs along y
+    for (size_t i = 0; i < w.curbs.size(); ++i) {
+      if (w.curb_kinds[i] != kind) continue;
+      const Polyline2d& l = w.curbs[i];
+      for (size_t k = 1; k < l.size(); ++k) {
+        const Eigen::Vector2d &a = l[k - 1], &b = l[k];
+        if (std::abs(a.y() - y) < 0.05 && std::abs(b.y() - y) < 0.05)
+          covered += std::max(0.0, std::min({std::max(a.x(), b.x()), 32.0}) - std::max({std::min(a.x(), b.x()), 8.0}));
+      }
+    }
+    return covered;
+  };
+  EXPECT_EQ(along(then, -3.0, "vertical"), 0.0);
+  EXPECT_NEAR(along(now, -3.0, "vertical"), 24.0, 0.1);
+  EXPECT_EQ(along(then, -4.0, "flush"), 0.0);
+  EXPECT_GT(along(now, -4.0, "flush"), 23.0);
+  RecordProperty("flush_m", std::to_string(along(now, -4.0, "flush")));
+}
+
 TEST(WorldChanges, AHedgeGrownSinceTheSurveyLeansOverTheCurbToday) {
   const World then = build(surveyed());
   const World now =
@@ -109,6 +145,8 @@ TEST(WorldChanges, MistakesAreErrorsAtTheirLine) {
   EXPECT_NE(message("  paint_worn: [{road: side, at: 10}]\n").find("unknown road 'side'"), std::string::npos);
   EXPECT_NE(message("  painted_worn: []\n").find("did you mean 'paint_worn'"), std::string::npos);
   EXPECT_NE(message("  construction: [{road: main, at: 20, side: both}]\n").find("one side"), std::string::npos);
+  // A kerb shifted past the closed lanes' outer half would stand in the barriers (8 m road: at most 1.5 m).
+  EXPECT_NE(message("  construction: [{road: main, at: 20, curb_shift: 1.6}]\n").find("curb_shift"), std::string::npos);
 }
 
 // The map is surveyed with the car parked; today it is gone. Its wheels and sills (below the mapping

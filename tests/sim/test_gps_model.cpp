@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "sim/gps_model.hpp"
 
@@ -47,6 +48,14 @@ std::vector<Sample> run(Model& model, int64_t duration_ns, const std::function<P
     out.push_back({x, model.sample(t, x)});
   }
   return out;
+}
+
+// The antenna at the rear axle, so that a fix's error is the receiver's alone (the lever arm has its
+// own test below).
+GpsConfig rear_axle_antenna() {
+  GpsConfig c;
+  c.antenna_xyz.setZero();
+  return c;
 }
 
 // Position error of a fix in the local frame (east, north), m.
@@ -92,7 +101,7 @@ constexpr double kStatsBiasTauS = 10, kStatsHeadingTauS = 5;
 constexpr int kStatsSeeds = 8;
 
 TEST(GpsErrorStatistics, PerAxisAndHeadingStdMatchConfigurationOverThirtyMinutes) {
-  GpsConfig config;
+  GpsConfig config = rear_axle_antenna();
   config.bias_tau_s = kStatsBiasTauS;
   config.heading_bias_tau_s = kStatsHeadingTauS;
   const LocalFrame frame(kOrigin);
@@ -120,7 +129,7 @@ TEST(GpsErrorStatistics, PerAxisAndHeadingStdMatchConfigurationOverThirtyMinutes
 }
 
 TEST(GpsErrorStatistics, CovarianceReportsTheConfiguredVariances) {
-  GpsConfig config;
+  GpsConfig config = rear_axle_antenna();
   GpsModel gps(config, LocalFrame(kOrigin), 1);
   const GpsFix fix = gps.sample(0, circle_truth(0));
   const double horizontal = config.bias_sigma_m * config.bias_sigma_m + config.white_sigma_m * config.white_sigma_m;
@@ -136,7 +145,7 @@ TEST(GpsErrorStatistics, CovarianceReportsTheConfiguredVariances) {
 // from the stationary law, not a zero one that grows in. One fix from each of many receivers.
 TEST(GpsErrorStatistics, FirstFixDrawsTheBiasFromItsStationaryLaw) {
   constexpr int kReceivers = 2000;  // 4000 independent axis errors: the std is known to ~1 %
-  GpsConfig config;
+  GpsConfig config = rear_axle_antenna();
   config.white_sigma_m = 0;
   config.heading_white_sigma_rad = 0;
   const LocalFrame frame(kOrigin);
@@ -168,7 +177,7 @@ struct TauEstimate {
 };
 
 TauEstimate estimate_tau(double rate_hz) {
-  GpsConfig config;
+  GpsConfig config = rear_axle_antenna();
   config.rate_hz = rate_hz;
   config.white_sigma_m = 0;
   config.heading_white_sigma_rad = 0;
@@ -221,11 +230,38 @@ TEST(GpsBiasCorrelation, ExactAtACoarseRate) {
   RecordProperty("bias_std_m", std::to_string(e.position_std_m));
 }
 
+// --- Lever arm -----------------------------------------------------------------------------------
+
+// With the noise off, a fix is exactly the antenna: the lever arm comes back from the fixes, turned
+// into the vehicle frame, whatever the heading (the circle turns through every heading).
+TEST(GpsLeverArm, FixesAreAtTheAntenna) {
+  GpsConfig config;
+  config.bias_sigma_m = config.white_sigma_m = config.vertical_sigma_m = 0;
+  config.heading_bias_sigma_rad = config.heading_white_sigma_rad = 0;
+  config.antenna_xyz = {1.5, 0.3, 1.6};
+  const LocalFrame frame(kOrigin);
+  GpsModel gps(config, frame, 4);
+  constexpr double kRoundTripM = 1e-6;  // the geodetic round trip
+  for (const Sample& s : run(gps, 70 * kSecond)) {
+    const Eigen::Vector2d arm = Eigen::Rotation2Dd(-s.truth.yaw) *
+                                (frame.to_local(s.fix.lat_deg, s.fix.lon_deg) - Eigen::Vector2d(s.truth.x, s.truth.y));
+    EXPECT_NEAR(arm.x(), config.antenna_xyz.x(), kRoundTripM);
+    EXPECT_NEAR(arm.y(), config.antenna_xyz.y(), kRoundTripM);
+    EXPECT_NEAR(s.fix.alt_m - kOrigin.alt_m, config.antenna_xyz.z(), kRoundTripM);
+  }
+}
+
+TEST(GpsLeverArm, IdealProfilePutsTheAntennaAtTheRearAxle) {
+  EXPECT_EQ(gps_config_for(Realism::ideal).antenna_xyz, Eigen::Vector3d::Zero());
+  EXPECT_EQ(gps_config_for(Realism::typical).antenna_xyz, GpsConfig{}.antenna_xyz);
+  EXPECT_GT(GpsConfig{}.antenna_xyz.head<2>().norm(), 0.5);  // a roof antenna, not at the axle
+}
+
 // --- Heading --------------------------------------------------------------------------------------
 
 TEST(GpsHeading, WrappedIntoMinusPiToPi) {
   constexpr int kSamples = 1000;
-  GpsConfig config;
+  GpsConfig config = rear_axle_antenna();
   config.heading_bias_sigma_rad = 0.5;  // large and fast, so that the heading crosses +-pi often
   config.heading_bias_tau_s = 1;
   GpsModel gps(config, LocalFrame(kOrigin), 3);
@@ -266,9 +302,9 @@ TEST(GpsZones, OutageCircleAndTimeWindow) {
   circle_in_window.radius_m = 20;
   circle_in_window.from_ns = 0;
   circle_in_window.to_ns = 200 * kSecond;
-  GpsConfig config;
+  GpsConfig config = rear_axle_antenna();
   config.zones = {circle, window, circle_in_window};
-  GpsConfig open_sky;
+  GpsConfig open_sky = rear_axle_antenna();
 
   const LocalFrame frame(kOrigin);
   GpsModel gps(config, frame, 5), reference(open_sky, frame, 5);
@@ -314,9 +350,9 @@ TEST(GpsZones, MultipathShiftsThePositionNotTheCovariance) {
   multipath.centre = {0, kCircleRadius};
   multipath.radius_m = 30;
   multipath.jump_m = {6, -4};
-  GpsConfig config;
+  GpsConfig config = rear_axle_antenna();
   config.zones = {multipath};
-  GpsConfig open_sky;
+  GpsConfig open_sky = rear_axle_antenna();
 
   const LocalFrame frame(kOrigin);
   GpsModel gps(config, frame, 9), reference(open_sky, frame, 9);
@@ -353,7 +389,7 @@ TEST(GpsZones, MultipathShiftsThePositionNotTheCovariance) {
 
 TEST(GpsDeterminism, SameSeedSameFixesOtherSeedOtherFixes) {
   constexpr int64_t kRunNs = 60 * kSecond;
-  GpsConfig config;
+  GpsConfig config = rear_axle_antenna();
   GpsZone multipath;
   multipath.kind = GpsZone::Kind::multipath;
   multipath.jump_m = {1, 2};
