@@ -97,9 +97,11 @@ std::vector<Eigen::Vector2d> detect_scan_curbs(const ScanPoints& points, const s
   return curbs;
 }
 
-// 2.2.2: grid S of the road surface's intensities around the vehicle (Eq. 8), placed at `pose`.
+// 2.2.2: grid S of the road surface's intensities around the vehicle (Eq. 8), placed at `pose`, each
+// laser's reading first put on the map's scale (beyond the paper: intensity_calibration.hpp).
 IntensityGrid intensity_grid(const ScanPoints& points, const std::vector<size_t>& ground, const Pose2d& pose,
-                             const IntensityGridParams& params, LocalizerEstimate& e) {
+                             const IntensityGridParams& params, const IntensityCalibration& calibration,
+                             LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::intensity_matching));
   std::vector<Eigen::Vector3d> ground_xyz;
   std::vector<double> intensities;
@@ -107,7 +109,7 @@ IntensityGrid intensity_grid(const ScanPoints& points, const std::vector<size_t>
   intensities.reserve(ground.size());
   for (size_t i : ground) {
     ground_xyz.push_back(points.xyz[i]);
-    intensities.push_back(points.intensity[i]);
+    intensities.push_back(calibration.correct(points.ring[i], points.intensity[i]));
   }
   return build_intensity_grid(ground_xyz, intensities, pose, params);
 }
@@ -168,7 +170,8 @@ Localizer::Localizer(HdMap& map, const LocalizerParams& params)
       frame_(map.curbs.map().origin),
       rng_(params.seed),
       predictor_(params.vehicle),
-      accumulator_(params.curb_features.frames) {}
+      accumulator_(params.curb_features.frames),
+      intensity_calibration_(params.intensity_calibration) {}
 
 void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance) {
   predict_to(stamp_ns);
@@ -299,7 +302,8 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
     features_.curbs =
         curb_features(detect_scan_curbs(points, plane, params_.curb_detector, e), features_.obstacles, motion, e);
   std::optional<IntensityGrid> S;
-  if (uses_intensity(method)) S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, e);  // 2.2.2
+  if (uses_intensity(method))  // 2.2.2
+    S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, intensity_calibration_, e);
 
   if (uses_curbs(method)) {
     const std::optional<CurbObservation> z = match_curbs(features_.curbs, e);  // 3.1
@@ -308,7 +312,28 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
   if (S) {
     const std::optional<ApsResult> z = match_intensity(*S, e);  // 3.2
     if (z) fuse_intensity(*z, e);                               // 3.3
+    const StageTimer timer(stage_ms(e, Stage::intensity_matching));
+    learn_intensity_calibration(points, ground);
   }
+}
+
+// Beyond the paper: this scan's ground points against the map's intensities under them, at the pose
+// the scan's updates left, teach each laser's calibration (intensity_calibration.hpp).
+void Localizer::learn_intensity_calibration(const ScanPoints& points, const std::vector<size_t>& ground) {
+  const IntensityCalibrationParams& c = params_.intensity_calibration;
+  const Eigen::Matrix3d& P = filter_->covariance();
+  const double sigma2 = c.max_position_sigma_m * c.max_position_sigma_m;
+  if (!c.enabled || P(0, 0) > sigma2 || P(1, 1) > sigma2) return;
+  const Pose2d pose = filter_->pose();
+  const double cos_yaw = std::cos(pose.yaw), sin_yaw = std::sin(pose.yaw);
+  for (size_t k = 0; k < ground.size(); k += size_t(c.point_stride)) {
+    const Eigen::Vector3d& p = points.xyz[ground[k]];
+    const Eigen::Vector2d xy(pose.x + cos_yaw * p.x() - sin_yaw * p.y(), pose.y + sin_yaw * p.x() + cos_yaw * p.y());
+    const std::optional<IntensityCell> cell = map_.intensity.cell(xy);
+    if (cell && int(cell->count) >= c.min_map_count)
+      intensity_calibration_.add(points.ring[ground[k]], points.intensity[ground[k]], cell->mean);
+  }
+  intensity_calibration_.end_scan();
 }
 
 Pose2d Localizer::motion_since_previous_scan() {

@@ -24,7 +24,9 @@
 #include "common/point_cloud.hpp"
 #include "common/vehicle_messages.hpp"
 #include "localizer/curb_features.hpp"
+#include "localizer/deskew.hpp"
 #include "localizer/hd_map.hpp"
+#include "localizer/intensity_calibration.hpp"
 #include "localizer/localizer_params.hpp"
 
 namespace lidarloop {
@@ -134,6 +136,7 @@ class Localizer {
   std::optional<ApsResult> match_intensity(IntensityGrid& S, LocalizerEstimate& e);
   ApsParams aps_window(const Pose2d& prior) const;
   void fuse_intensity(const ApsResult& aps, LocalizerEstimate& e);
+  void learn_intensity_calibration(const ScanPoints& points, const std::vector<size_t>& ground);
   void report_pose(LocalizerEstimate& e) const;
   // The chi^2 gate, with the filter's doubt growing after max_rejections in a row (see
   // HealthParams); true: use the observation.
@@ -154,6 +157,7 @@ class Localizer {
   CurbAccumulator accumulator_;
   std::optional<Pose2d> previous_scan_odometry_;
   int curb_rejections_ = 0, intensity_rejections_ = 0;
+  IntensityCalibration intensity_calibration_;
   ScanFeatures features_;
 };
 

@@ -105,6 +105,20 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("cell_m", p.intensity_grid.cell_m, 0.01, 2.0)
       .number("max_height", p.intensity_grid.max_height, 0.01, 10.0)
       .done();
+  YamlMap(y, top["intensity_calibration"], "intensity_calibration")
+      .boolean("enabled", p.intensity_calibration.enabled)
+      .number("forgetting", p.intensity_calibration.forgetting, 0.0, 1.0)
+      .number("prior_points", p.intensity_calibration.prior_points, 1.0, 1e9)
+      .number("prior_dark", p.intensity_calibration.prior_dark, 0.0, 255.0)
+      .number("prior_bright", p.intensity_calibration.prior_bright, 0.0, 255.0)
+      .integer("min_map_count", p.intensity_calibration.min_map_count, 1, 1000000)
+      .number("max_position_sigma_m", p.intensity_calibration.max_position_sigma_m, 0.0, 100.0)
+      .integer("point_stride", p.intensity_calibration.point_stride, 1, 1000)
+      .number("min_gain", p.intensity_calibration.min_gain, 0.01, 1.0)
+      .number("max_gain", p.intensity_calibration.max_gain, 1.0, 100.0)
+      .done();
+  if (!(p.intensity_calibration.prior_bright > p.intensity_calibration.prior_dark))
+    y.fail(top["intensity_calibration"], "intensity_calibration: prior_bright must exceed prior_dark");
   YamlMap(y, top["aps"], "aps")
       .number("lateral_range_m", p.aps.lateral_range_m, 0.0, 20.0)
       .number("longitudinal_range_m", p.aps.longitudinal_range_m, 0.0, 20.0)

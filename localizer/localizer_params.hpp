@@ -16,6 +16,7 @@
 #include "localizer/curb_match_covariance.hpp"
 #include "localizer/driving_corridor.hpp"
 #include "localizer/fmt_matcher.hpp"
+#include "localizer/intensity_calibration.hpp"
 #include "localizer/obstacle_rejection.hpp"
 #include "localizer/pose_filter.hpp"
 #include "localizer/probabilistic_icp.hpp"
@@ -76,6 +77,7 @@ struct LocalizerParams {
   MIcpParams m_icp;
   FmtParams fmt;
   IntensityGridParams intensity_grid;
+  IntensityCalibrationParams intensity_calibration;  // beyond the paper: see intensity_calibration.hpp
   ApsParams aps;
   // Beyond the paper: APS's window (+-1 m, +-3 m) assumes the prior is already that good. While it is
   // not (the first GPS fix, after an outage), the window grows to this many prior sigmas, up to the

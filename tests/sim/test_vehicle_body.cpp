@@ -195,7 +195,11 @@ roads:
 )";
   scenario = parse_scenario("world: straight\nduration_s: 6\nrealism: " + realism +
                                 "\nego: {route: {road: main, lane: left}, start_at: 40, speed: 8, initial_speed: 8, "
-                                "stops: [{at: 70, duration_s: 5}]}\n",
+                                "stops: [{at: 70, duration_s: 5}]}\n"
+                                // The scan's stamp on the reference clock and the nominal mount, so that
+                                // each scan can be found in the truth and checked against it.
+                                "clocks: {lidar_jitter_ms: 0}\n"
+                                "mount_error: {lidar_rotation_deg: [0, 0, 0], lidar_translation_m: [0, 0, 0]}\n",
                             "brake.yaml");
   const WorldDescription description = parse_world_description(world_yaml, "straight.yaml");
   world = build_world(description, test::materials(), test::data_path("assets/actors"));
