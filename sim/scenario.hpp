@@ -87,8 +87,8 @@ struct Scenario {
   CanConfig can;
   GpsConfig gps;
   RtkConfig rtk;
-  BodyConfig body;  // the ego's suspension (`body`)
-  WeatherConfig weather;  // the day the scenario is driven on (the map was surveyed on a dry one)
+  BodyConfig body;               // the ego's suspension (`body`)
+  WeatherConfig weather;         // the day the scenario is driven on (the map was surveyed on a dry one)
   MountErrorConfig mount_error;  // the true LiDAR mount and GPS antenna against the nominal `lidar` / `gps` ones
   ClockConfig clocks;            // the LiDAR's and the CAN's stamping clocks against the reference
   std::vector<TrafficSpec> traffic;
