@@ -7,10 +7,11 @@ namespace lidarloop {
 
 IntensityCalibration::IntensityCalibration(const IntensityCalibrationParams& params) : params_(params) {}
 
-void IntensityCalibration::add(int ring, double reading, double map_mean) {
-  if (!valid(ring) || !std::isfinite(reading) || !std::isfinite(map_mean)) return;
+void IntensityCalibration::add(int ring, double reading, double map_mean, double weight) {
+  if (!valid(ring) || !std::isfinite(reading) || !std::isfinite(map_mean) || !(weight > 0)) return;
   Sums& s = sums_[size_t(ring)];
-  s.n += 1, s.x += map_mean, s.y += reading, s.xx += map_mean * map_mean, s.xy += map_mean * reading;
+  const double w = weight;
+  s.n += w, s.x += w * map_mean, s.y += w * reading, s.xx += w * map_mean * map_mean, s.xy += w * map_mean * reading;
 }
 
 void IntensityCalibration::end_scan() {

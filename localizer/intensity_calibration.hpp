@@ -12,6 +12,11 @@
 // exponential forgetting, and a prior of `prior_points` dark and `prior_points` bright pseudo-returns
 // read true (g = 1, o = 0), so a laser that has seen only asphalt keeps its gain near one. Scans are
 // corrected by inverting the fit before they enter S: x = (y - o) / g.
+//
+// At a cold start the pose is metres off and the map cannot be asked what a point should read. The
+// lasers can still be made to agree with each other: most of a scan's road surface is asphalt, so each
+// laser's median ground reading against the median of all of them is that laser's offset on asphalt
+// (a pose-free pair, weighted as the points behind it), until the filter knows where it is.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -29,7 +34,8 @@ struct IntensityCalibrationParams {
   // this well (1 sigma, m, on either axis): a point placed metres off compares unlike with unlike.
   int min_map_count = 3;
   double max_position_sigma_m = 0.5;
-  int point_stride = 4;  // learn from every n-th ground point (the fit needs hundreds, a scan has thousands)
+  int point_stride = 4;      // learn from every n-th ground point (the fit needs hundreds, a scan has thousands)
+  int min_ring_points = 50;  // pose-free: a laser's median ground reading from at least this many points
   double min_gain = 0.5, max_gain = 2.0;
 };
 
@@ -41,7 +47,7 @@ class IntensityCalibration {
 
   // One scan's pairs: `ring` read `reading` where the map's cell has mean `map_mean`. Call once per pair,
   // then end_scan() once.
-  void add(int ring, double reading, double map_mean);
+  void add(int ring, double reading, double map_mean, double weight = 1);
   void end_scan();  // applies the forgetting and refits every laser
 
   // The reading of `ring` as the map's unit would have read it (unchanged for an unknown ring).

@@ -17,6 +17,12 @@
 namespace lidarloop {
 namespace {
 
+// The upper median (the values are reordered).
+double median_of(std::vector<double>& values) {
+  std::nth_element(values.begin(), values.begin() + long(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
+
 // Before the first fix there is no pose: the estimate says so with this (m^2, rad^2) on the diagonal.
 constexpr double kUnknownVariance = 1e6;
 // APS's window is rounded down to whole steps; a window meant to be a whole number of steps must not
@@ -302,6 +308,11 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
     features_.curbs =
         curb_features(detect_scan_curbs(points, plane, params_.curb_detector, e), features_.obstacles, motion, e);
   std::optional<IntensityGrid> S;
+  const bool map_calibration = uses_intensity(method) && calibration_needs_the_pose();
+  if (uses_intensity(method) && !map_calibration) {
+    const StageTimer timer(stage_ms(e, Stage::intensity_matching));
+    calibrate_lasers_to_each_other(points, ground);
+  }
   if (uses_intensity(method))  // 2.2.2
     S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, intensity_calibration_, e);
 
@@ -312,18 +323,44 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
   if (S) {
     const std::optional<ApsResult> z = match_intensity(*S, e);  // 3.2
     if (z) fuse_intensity(*z, e);                               // 3.3
+  }
+  if (map_calibration) {
     const StageTimer timer(stage_ms(e, Stage::intensity_matching));
-    learn_intensity_calibration(points, ground);
+    calibrate_lasers_to_the_map(points, ground);
   }
 }
 
-// Beyond the paper: this scan's ground points against the map's intensities under them, at the pose
-// the scan's updates left, teach each laser's calibration (intensity_calibration.hpp).
-void Localizer::learn_intensity_calibration(const ScanPoints& points, const std::vector<size_t>& ground) {
-  const IntensityCalibrationParams& c = params_.intensity_calibration;
+// Beyond the paper: this scan's ground points teach each laser's calibration (intensity_calibration.hpp).
+// Until the filter knows where the car is: before S is built, each laser's median ground reading against
+// the median of all lasers (no pose needed). Then: after the scan's updates, against the map's
+// intensities under the points at the updated pose. One of the two per scan.
+bool Localizer::calibration_needs_the_pose() const {
   const Eigen::Matrix3d& P = filter_->covariance();
-  const double sigma2 = c.max_position_sigma_m * c.max_position_sigma_m;
-  if (!c.enabled || P(0, 0) > sigma2 || P(1, 1) > sigma2) return;
+  const double sigma = params_.intensity_calibration.max_position_sigma_m;
+  return P(0, 0) <= sigma * sigma && P(1, 1) <= sigma * sigma;
+}
+
+void Localizer::calibrate_lasers_to_each_other(const ScanPoints& points, const std::vector<size_t>& ground) {
+  const IntensityCalibrationParams& c = params_.intensity_calibration;
+  if (!c.enabled || ground.empty()) return;
+  std::vector<std::vector<double>> by_ring(IntensityCalibration::kMaxLasers);
+  std::vector<double> all;
+  all.reserve(ground.size());
+  for (size_t i : ground) {
+    all.push_back(points.intensity[i]);
+    if (points.ring[i] < by_ring.size()) by_ring[points.ring[i]].push_back(points.intensity[i]);
+  }
+  const double all_median = median_of(all);
+  for (size_t ring = 0; ring < by_ring.size(); ++ring)
+    if (by_ring[ring].size() >= size_t(c.min_ring_points))
+      intensity_calibration_.add(int(ring), median_of(by_ring[ring]), all_median,
+                                 double(by_ring[ring].size()) / double(c.point_stride));
+  intensity_calibration_.end_scan();
+}
+
+void Localizer::calibrate_lasers_to_the_map(const ScanPoints& points, const std::vector<size_t>& ground) {
+  const IntensityCalibrationParams& c = params_.intensity_calibration;
+  if (!c.enabled || ground.empty()) return;
   const Pose2d pose = filter_->pose();
   const double cos_yaw = std::cos(pose.yaw), sin_yaw = std::sin(pose.yaw);
   for (size_t k = 0; k < ground.size(); k += size_t(c.point_stride)) {

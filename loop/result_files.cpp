@@ -113,7 +113,12 @@ std::string metrics_json(const Metrics& m) {
   const json doc = {
       {"method", m.method},
       {"scenario", m.scenario},
-      {"realism", {{"profile", m.realism}, {"overrides", m.realism_overrides}}},
+      {"realism",
+       {{"profile", m.realism},
+        {"overrides", m.realism_overrides},
+        {"lidar_mount_error",
+         {{"rpy_deg", {m.mount_error_rpy_deg.x(), m.mount_error_rpy_deg.y(), m.mount_error_rpy_deg.z()}},
+          {"xyz_m", {m.mount_error_xyz_m.x(), m.mount_error_xyz_m.y(), m.mount_error_xyz_m.z()}}}}}},
       {"frames", m.frames},
       {"unscored_frames", m.unscored_frames},
       {"settling_frames", m.settling_frames},

@@ -7,6 +7,7 @@
 #include "loop/birdseye.hpp"
 #include "loop/error_plots.hpp"
 #include "loop/result_files.hpp"
+#include "sim/sensor_calibration.hpp"
 
 namespace lidarloop {
 namespace {
@@ -56,6 +57,9 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
   ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name);
   scored.metrics.realism = realism_name(scenario.realism);
   scored.metrics.realism_overrides = realism_overrides(scenario);
+  const MountDraw mount = draw_mount_error(scenario.mount_error, scenario.seed);  // as the simulation drew it
+  scored.metrics.mount_error_rpy_deg = mount.lidar_rpy_rad * kDegPerRad;
+  scored.metrics.mount_error_xyz_m = mount.lidar_xyz_m;
 
   std::filesystem::create_directories(dir);
   write_metrics_json(dir + "/metrics.json", scored.metrics);

@@ -54,6 +54,9 @@ struct Metrics {
   // The run's realism profile and the knobs the scenario set on top of it (labels, not scored).
   std::string realism;
   std::vector<std::string> realism_overrides;
+  // This run's draw of the true LiDAR mount against the nominal one the localizer is given: roll,
+  // pitch, yaw (deg) and x, y, z (m).
+  Eigen::Vector3d mount_error_rpy_deg = Eigen::Vector3d::Zero(), mount_error_xyz_m = Eigen::Vector3d::Zero();
   size_t frames = 0;           // estimates scored
   size_t unscored_frames = 0;  // estimates outside the truth's time range (not scored, reported)
   size_t settling_frames = 0;  // estimates within thresholds.settle_s of the first (not scored)

@@ -9,12 +9,14 @@
 #include <sstream>
 
 #include "common/input_error.hpp"
+#include "common/units.hpp"
 #include "loop/localizer_loop.hpp"
 #include "loop/localizer_setup.hpp"
 #include "loop/paper_tables.hpp"
 #include "loop/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "loop/run_recording.hpp"
+#include "sim/sensor_calibration.hpp"
 #include "tools/commands.hpp"
 #include "tools/scene_setup.hpp"
 
@@ -53,6 +55,12 @@ void print_realism(const Scenario& s) {
   std::printf("realism    %s%s\n", realism_name(s.realism),
               overrides.empty() ? ", no knob overridden" : ", with the scenario's own settings:");
   for (const auto& o : overrides) std::printf("           %s\n", o.c_str());
+  const MountDraw m = draw_mount_error(s.mount_error, s.seed);
+  const Eigen::Vector3d rpy = m.lidar_rpy_rad * kDegPerRad, xyz = m.lidar_xyz_m * 1e3;
+  std::printf(
+      "mount      the LiDAR's true mount against the nominal one the localizer is given: roll %.3f, "
+      "pitch %.3f, yaw %.3f deg; x %.1f, y %.1f, z %.1f mm\n",
+      rpy.x(), rpy.y(), rpy.z(), xyz.x(), xyz.y(), xyz.z());
 }
 
 struct Progress {
