@@ -2,9 +2,10 @@
 // Realism profiles (scenario key `realism`): one word that selects sourced defaults for every realism
 // knob of the world, the map, the body and the sensor; any knob can still be overridden in its own
 // section of the scenario (`lidar`, `body`, `weather`, `clocks`, ...).
-//   ideal    the clean simulator: flat ground, ideal curbs, a map that is the world, a rigid body,
-//            a perfectly calibrated sensor with identical lasers, synchronous clocks, a dry day
-//            (for debugging and unit tests);
+//   ideal    the simulator before realism: flat ground, ideal curbs, a map that is the world, a rigid
+//            body, the nominal mount, synchronous clocks, a dry day, and the HDL-32E as it was (range
+//            noise and its unit's per-laser gains, but no per-laser range biases or intensity offsets,
+//            no mixed returns) (for debugging and unit tests);
 //   typical  a well-kept campus on a dry day, a survey-grade map, a factory-calibrated sensor;
 //   harsh    a worn map, rain, a poorly calibrated sensor.
 // Each knob's config struct has the `typical` values as its defaults, with their sources beside them,
