@@ -50,11 +50,13 @@ LoadedScenario load_with_overrides(const Args& args) {
 }
 
 // The realism profile and the knobs the scenario sets on top of it.
-void print_realism(const Scenario& s) {
+// `mount`: also the LiDAR mount error drawn for the scenario's seed (one run's).
+void print_realism(const Scenario& s, bool mount = true) {
   const std::vector<std::string> overrides = realism_overrides(s);
   std::printf("realism    %s%s\n", realism_name(s.realism),
               overrides.empty() ? ", no knob overridden" : ", with the scenario's own settings:");
   for (const auto& o : overrides) std::printf("           %s\n", o.c_str());
+  if (!mount) return;
   const MountDraw m = draw_mount_error(s.mount_error, s.seed);
   const Eigen::Vector3d rpy = m.lidar_rpy_rad * kDegPerRad, xyz = m.lidar_xyz_m * 1e3;
   std::printf(
@@ -262,7 +264,7 @@ int run_compare(const Args& args) {
   std::printf("\nscenario   %s, %zu seeds (--seeds %s), %.1f s each; ours: mean (smallest-largest) over the seeds%s\n",
               s.scenario.file.c_str(), all.size() / std::max<size_t>(methods.size(), 1), args.value("seeds")->c_str(),
               s.scenario.duration_s, paper ? "" : "; paper: Table III (give --paper static for Table II)");
-  print_realism(s.scenario);
+  print_realism(s.scenario, false);  // each seed drew its own mount error (metrics.json)
   std::printf("files      %s/ (seeds.md, comparison.csv, seed_<N>/...)\n", out.c_str());
   return status;
 }
