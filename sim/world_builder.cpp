@@ -21,13 +21,14 @@ constexpr double kCurbStation = 0.5;      // m between cross-sections of the cur
 constexpr double kPaintPiece = 0.5;       // m; paint is draped over the pavement in pieces this long
 constexpr double kIntersectionPad = 2.0;  // m beyond the corner radius where lane paint stops
 constexpr double kCrosswalkPad = 1.0;     // m before a crosswalk where lane paint stops
-// Work zones. Cones: MUTCD (2009) 6F.64, at least 28 in (0.71 m) tall, with a retro-reflective band for
-// night use; spaced in feet at about the speed in mph (6C.08: 30 km/h ~ 20 mph ~ 6 m), 0.3 m inside
-// the closed side. Barriers: the New Jersey / F-shape concrete safety barrier, 32 in (0.81 m) tall,
-// 24 in (0.61 m) at its base, in 12.5 ft (3.8 m) segments.
+// Work zones. Cones: MUTCD (2009) 6F.64, at least 28 in (0.71 m) tall; for night use a 6 in (0.15 m)
+// white retro-reflective band 3 to 4 in below the top (0.47-0.62 m; the 4 in band below it is left out),
+// standing 1 cm proud of the cone's surface; spaced in feet at about the speed in mph (6C.08: 30 km/h ~
+// 20 mph ~ 6 m), 0.3 m inside the closed side. Barriers: the New Jersey / F-shape concrete safety
+// barrier, 32 in (0.81 m) tall, 24 in (0.61 m) at its base, in 12.5 ft (3.8 m) segments.
 constexpr double kConeSpacing = 6.0, kConeInset = 0.3;                                                   // m
 constexpr float kConeHeight = 0.71f, kConeBaseRadius = 0.18f, kConeTopRadius = 0.03f;                    // m
-constexpr float kBandLow = 0.40f, kBandHigh = 0.55f, kBandRadiusLow = 0.105f, kBandRadiusHigh = 0.075f;  // m
+constexpr float kBandLow = 0.47f, kBandHigh = 0.62f, kBandRadiusLow = 0.091f, kBandRadiusHigh = 0.059f;  // m
 constexpr double kBarrierLength = 3.8, kBarrierJoint = 0.05;         // m; a barrier segment and half the gap between
 constexpr float kBarrierHeight = 0.81f, kBarrierHalfWidth = 0.305f;  // m
 // A construction zone's temporary kerb: precast blocks 1 m long and 0.3 m wide (assumption: the common
