@@ -308,7 +308,7 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
     features_.curbs =
         curb_features(detect_scan_curbs(points, plane, params_.curb_detector, e), features_.obstacles, motion, e);
   std::optional<IntensityGrid> S;
-  const bool map_calibration = uses_intensity(method) && calibration_needs_the_pose();
+  const bool map_calibration = uses_intensity(method) && pose_known_to_calibrate();
   if (uses_intensity(method) && !map_calibration) {
     const StageTimer timer(stage_ms(e, Stage::intensity_matching));
     calibrate_lasers_to_each_other(points, ground);
@@ -334,7 +334,7 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
 // Until the filter knows where the car is: before S is built, each laser's median ground reading against
 // the median of all lasers (no pose needed). Then: after the scan's updates, against the map's
 // intensities under the points at the updated pose. One of the two per scan.
-bool Localizer::calibration_needs_the_pose() const {
+bool Localizer::pose_known_to_calibrate() const {
   const Eigen::Matrix3d& P = filter_->covariance();
   const double sigma = params_.intensity_calibration.max_position_sigma_m;
   return P(0, 0) <= sigma * sigma && P(1, 1) <= sigma * sigma;
@@ -362,11 +362,8 @@ void Localizer::calibrate_lasers_to_the_map(const ScanPoints& points, const std:
   const IntensityCalibrationParams& c = params_.intensity_calibration;
   if (!c.enabled || ground.empty()) return;
   const Pose2d pose = filter_->pose();
-  const double cos_yaw = std::cos(pose.yaw), sin_yaw = std::sin(pose.yaw);
   for (size_t k = 0; k < ground.size(); k += size_t(c.point_stride)) {
-    const Eigen::Vector3d& p = points.xyz[ground[k]];
-    const Eigen::Vector2d xy(pose.x + cos_yaw * p.x() - sin_yaw * p.y(), pose.y + sin_yaw * p.x() + cos_yaw * p.y());
-    const std::optional<IntensityCell> cell = map_.intensity.cell(xy);
+    const std::optional<IntensityCell> cell = map_.intensity.cell(pose.apply(points.xyz[ground[k]].head<2>()));
     if (cell && int(cell->count) >= c.min_map_count)
       intensity_calibration_.add(points.ring[ground[k]], points.intensity[ground[k]], cell->mean);
   }

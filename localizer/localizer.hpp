@@ -136,7 +136,7 @@ class Localizer {
   std::optional<ApsResult> match_intensity(IntensityGrid& S, LocalizerEstimate& e);
   ApsParams aps_window(const Pose2d& prior) const;
   void fuse_intensity(const ApsResult& aps, LocalizerEstimate& e);
-  bool calibration_needs_the_pose() const;
+  bool pose_known_to_calibrate() const;
   void calibrate_lasers_to_each_other(const ScanPoints& points, const std::vector<size_t>& ground);
   void calibrate_lasers_to_the_map(const ScanPoints& points, const std::vector<size_t>& ground);
   void report_pose(LocalizerEstimate& e) const;

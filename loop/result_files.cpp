@@ -21,14 +21,6 @@ using json = nlohmann::ordered_json;  // keys in the order written, for people r
 
 constexpr int kJsonIndent = 2;
 
-void write_text_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(path + ": cannot open for writing");
-  out << text;
-  out.close();
-  if (!out) throw InputError(path + ": cannot write");
-}
-
 std::string format(const char* pattern, double value) {
   char text[64];
   std::snprintf(text, sizeof text, pattern, value);
@@ -108,6 +100,14 @@ std::string markdown_cell(std::string s) {
 }
 
 }  // namespace
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw InputError(path + ": cannot open for writing");
+  out << text;
+  out.close();
+  if (!out) throw InputError(path + ": cannot write");
+}
 
 std::string metrics_json(const Metrics& m) {
   const json doc = {

@@ -10,6 +10,9 @@
 
 namespace lidarloop {
 
+// Writes `text` to `path` as it is; InputError naming the path when it cannot.
+void write_text_file(const std::string& path, const std::string& text);
+
 // metrics.json: every Metrics field (thresholds as an object, unset ones null; undefined values such
 // as the RMSE of zero frames are null too, since JSON has no NaN).
 std::string metrics_json(const Metrics& metrics);

@@ -24,12 +24,7 @@ namespace lidarloop {
 namespace {
 
 MappingOptions mapping_options(const Args& args) {
-  std::optional<Realism> realism = Realism::typical;
-  if (const auto word = args.value("realism")) {
-    realism = parse_realism(*word);
-    if (!realism) throw InputError("--realism must be ideal, typical or harsh, got '" + *word + "'");
-  }
-  MappingOptions o = mapping_options_for(*realism);
+  MappingOptions o = mapping_options_for(realism_option(args).value_or(Realism::typical));
   o.traffic = args.flag("traffic");
   o.resolution = args.number("resolution", o.resolution);
   if (o.resolution < 0.05 || o.resolution > 2.0) throw InputError("--resolution must be 0.05 to 2 m");

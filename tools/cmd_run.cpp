@@ -28,21 +28,9 @@ namespace {
 constexpr size_t kObstacleScanPoints = 20;
 constexpr size_t kMaxSeeds = 100;  // --seeds: a typo's guard, not a limit of the method
 
-void write_text(const std::string& path, const std::string& text) {
-  FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) throw InputError(path + ": cannot write file");
-  std::fputs(text.c_str(), f);
-  std::fclose(f);
-}
-
 // The scenario named on the command line, with --seed and --duration applied.
 LoadedScenario load_with_overrides(const Args& args) {
-  std::optional<Realism> realism;
-  if (const auto word = args.value("realism")) {
-    realism = parse_realism(*word);
-    if (!realism) throw InputError("--realism must be ideal, typical or harsh, got '" + *word + "'");
-  }
-  LoadedScenario s = load_scenario_and_world(args.positional().at(0), realism);
+  LoadedScenario s = load_scenario_and_world(args.positional().at(0), realism_option(args));
   if (args.value("seed")) s.scenario.seed = uint64_t(args.integer("seed", 0, 0, 1L << 62));
   if (args.value("duration")) s.scenario.duration_s = args.number("duration", s.scenario.duration_s);
   if (s.scenario.duration_s <= 0) throw InputError("--duration must be positive");
@@ -189,7 +177,7 @@ std::vector<Metrics> compare_once(const LoadedScenario& s, const std::vector<std
                           .metrics);
   write_junit(out + "/junit.xml", metrics);
   write_comparison_csv(out + "/comparison.csv", metrics);
-  write_text(out + "/comparison.md", comparison_markdown(metrics));
+  write_text_file(out + "/comparison.md", comparison_markdown(metrics));
   return metrics;
 }
 
@@ -259,7 +247,7 @@ int run_compare(const Args& args) {
   const std::string table = paper ? paper_comparison_markdown(*paper, summary)
                                   : paper_comparison_markdown(PaperTable::dynamic_campus, summary);
   write_comparison_csv(out + "/comparison.csv", all);
-  write_text(out + "/seeds.md", table);
+  write_text_file(out + "/seeds.md", table);
   std::cout << "\n" << table;
   std::printf("\nscenario   %s, %zu seeds (--seeds %s), %.1f s each; ours: mean (smallest-largest) over the seeds%s\n",
               s.scenario.file.c_str(), all.size() / std::max<size_t>(methods.size(), 1), args.value("seeds")->c_str(),

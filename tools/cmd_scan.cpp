@@ -17,6 +17,14 @@ int thread_count(const Args& args) {
   return n > 0 ? int(n) : int(std::max(1u, std::thread::hardware_concurrency()));
 }
 
+std::optional<Realism> realism_option(const Args& args) {
+  const auto word = args.value("realism");
+  if (!word) return std::nullopt;
+  const std::optional<Realism> realism = parse_realism(*word);
+  if (!realism) throw InputError("--realism must be ideal, typical or harsh, got '" + *word + "'");
+  return realism;
+}
+
 static int run_scan(const Args& args) {
   const int threads = thread_count(args);
   const auto limit = limit_threads(threads);

@@ -1,7 +1,9 @@
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "sim/realism.hpp"
 #include "tools/cli_args.hpp"
 
 namespace lidarloop {
@@ -29,5 +31,7 @@ int run_bench_loop(const Args& args);
 
 // --threads N: 0 means all cores. Returns the effective count.
 int thread_count(const Args& args);
+// --realism ideal|typical|harsh, if given; InputError for any other word.
+std::optional<Realism> realism_option(const Args& args);
 
 }  // namespace lidarloop
