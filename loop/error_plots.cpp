@@ -11,23 +11,22 @@
 
 #include "common/input_error.hpp"
 #include "common/units.hpp"
+#include "loop/plot_canvas.hpp"
 
 namespace lidarloop {
 
 namespace {
 
-constexpr int kMinWidth = 400, kMinHeight = 300;
+using namespace plot;
 
-// Look: black ink on white, one font, anti-aliased.
-const cv::Scalar kWhite(255, 255, 255), kInk(30, 30, 30), kGrid(225, 225, 225), kZero(150, 150, 150),
-    kCurve(180, 90, 30), kTruth(120, 120, 120), kEstimate(60, 60, 60), kBackground(205, 205, 205), kStart(40, 160, 40),
-    kWorst(0, 0, 200);
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
-constexpr double kTickFontScale = 0.5, kTitleFontScale = 0.65;
+
+// Look: the plot canvas's ink, and the curves' own colours.
+const cv::Scalar kCurve(180, 90, 30), kTruth(120, 120, 120), kEstimate(60, 60, 60), kBackground(205, 205, 205),
+    kStart(40, 160, 40), kWorst(0, 0, 200);
 
 // Error plot layout, pixels.
 constexpr int kLeftMargin = 90, kRightMargin = 30, kTopMargin = 10, kBottomMargin = 50;
-constexpr int kPanelTitleHeight = 30, kPanelTickLabelHeight = 28, kTickLength = 5;
+constexpr int kPanelTitleHeight = 30, kPanelTickLabelHeight = 28;
 constexpr int kTargetTimeTicks = 10, kTargetValueTicks = 5;
 constexpr double kValuePadFraction = 0.1;  // room above and below the curve
 constexpr double kMinHalfRange = 0.05;     // m or deg: an all-zero curve still gets an axis
@@ -41,104 +40,15 @@ constexpr int kErrorLineThickness = 5, kMarkerRadius = 8;
 constexpr double kMinColourScale_m = 0.01;
 constexpr int kColourBarTicks = 5;
 
-void check_size(const std::string& path, const PlotSize& size) {
-  if (size.width < kMinWidth || size.height < kMinHeight)
-    throw InputError(path + ": plot size " + std::to_string(size.width) + "x" + std::to_string(size.height) +
-                     " is too small (at least " + std::to_string(kMinWidth) + "x" + std::to_string(kMinHeight) + ")");
-}
-
-void save(const std::string& path, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception&) {  // OpenCV throws for some unwritable paths, returns false for others
-  }
-  if (!ok) throw InputError(path + ": cannot write PNG");
-}
-
-enum class Align { left, centre, right };
-
-// Text with its baseline at `at`, aligned horizontally about at.x.
-void text(cv::Mat& image, const std::string& s, cv::Point at, double scale = kTickFontScale, Align align = Align::left,
-          const cv::Scalar& colour = kInk) {
-  int baseline = 0;
-  const cv::Size size = cv::getTextSize(s, kFont, scale, 1, &baseline);
-  if (align == Align::centre) at.x -= size.width / 2;
-  if (align == Align::right) at.x -= size.width;
-  cv::putText(image, s, at, kFont, scale, colour, 1, cv::LINE_AA);
-}
-
-// 1, 2 or 5 times a power of ten, the largest not above `value`.
-double nice_floor(double value) {
-  const double decade = std::pow(10.0, std::floor(std::log10(value)));
-  for (double m : {5.0, 2.0, 1.0})
-    if (m * decade <= value) return m * decade;
-  return decade;
-}
-
-// A 1-2-5 step giving about `target` ticks over the span.
-double tick_step(double span, int target) {
-  const double raw = span / target;
-  const double decade = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0})
-    if (m * decade >= raw) return m * decade;
-  return 10 * decade;
-}
-
-std::vector<double> ticks(double lo, double hi, double step) {
-  std::vector<double> out;
-  for (double v = std::ceil(lo / step) * step; v <= hi + step * 1e-9; v += step)
-    out.push_back(std::abs(v) < step * 1e-9 ? 0 : v);
-  return out;
-}
-
-// Enough decimals to tell neighbouring ticks apart.
-std::string tick_label(double value, double step) {
-  const int decimals = std::max(0, int(std::ceil(-std::log10(step) - 1e-9)));
-  char s[32];
-  std::snprintf(s, sizeof s, "%.*f", decimals, value);
-  return s;
-}
-
-std::string fixed(double value, int decimals) {
-  char s[32];
-  std::snprintf(s, sizeof s, "%.*f", decimals, value);
-  return s;
-}
-
-struct Panel {
-  cv::Rect area;          // the plotting area inside the axes
-  double t0, t1, v0, v1;  // data ranges mapped onto it
-  cv::Point at(double t, double v) const {
-    return {area.x + int(std::lround((t - t0) / (t1 - t0) * area.width)),
-            area.y + area.height - int(std::lround((v - v0) / (v1 - v0) * area.height))};
-  }
-};
-
 void draw_panel(cv::Mat& image, const Panel& p, const std::vector<double>& t, const std::vector<double>& v,
                 const std::string& title) {
-  const double t_step = tick_step(p.t1 - p.t0, kTargetTimeTicks), v_step = tick_step(p.v1 - p.v0, kTargetValueTicks);
-  for (double tick : ticks(p.t0, p.t1, t_step)) {
-    const cv::Point q = p.at(tick, p.v0);
-    cv::line(image, {q.x, p.area.y}, q, kGrid, 1);
-    cv::line(image, q, {q.x, q.y + kTickLength}, kInk, 1);
-    text(image, tick_label(tick, t_step), {q.x, q.y + kTickLength + kPanelTickLabelHeight / 2 + 2}, kTickFontScale,
-         Align::centre);
-  }
-  for (double tick : ticks(p.v0, p.v1, v_step)) {
-    const cv::Point q = p.at(p.t0, tick);
-    cv::line(image, q, {p.area.x + p.area.width, q.y}, kGrid, 1);
-    cv::line(image, {q.x - kTickLength, q.y}, q, kInk, 1);
-    text(image, tick_label(tick, v_step), {q.x - kTickLength - 4, q.y + 5}, kTickFontScale, Align::right);
-  }
-  cv::line(image, p.at(p.t0, 0), p.at(p.t1, 0), kZero, 2);
+  draw_axes(image, p, title, kTargetTimeTicks, kTargetValueTicks);
+  cv::line(image, p.at(p.x0, 0), p.at(p.x1, 0), kZero, 2);
   // The curve, broken where a value is not finite (a diverged estimate) rather than drawn through it.
   for (size_t i = 1; i < t.size(); ++i)
     if (std::isfinite(v[i - 1]) && std::isfinite(v[i]))
       cv::line(image, p.at(t[i - 1], v[i - 1]), p.at(t[i], v[i]), kCurve, 2, cv::LINE_AA);
   if (t.size() == 1 && std::isfinite(v[0])) cv::circle(image, p.at(t[0], v[0]), 3, kCurve, cv::FILLED, cv::LINE_AA);
-  cv::rectangle(image, p.area, kInk, 1);
-  text(image, title, {p.area.x, p.area.y - 10}, kTitleFontScale);
 }
 
 // A colour for 0..1 from OpenCV's Turbo map (blue = small, red = large).
@@ -157,7 +67,7 @@ cv::Scalar turbo(double fraction) {
 }  // namespace
 
 void write_error_plot(const std::string& path, const std::vector<FrameError>& errors, const PlotSize& size) {
-  check_size(path, size);
+  check_size(path, size.width, size.height);
   cv::Mat image(size.height, size.width, CV_8UC3, kWhite);
   std::vector<double> t, lateral, longitudinal, heading;
   for (const auto& e : errors) {
@@ -185,7 +95,7 @@ void write_error_plot(const std::string& path, const std::vector<FrameError>& er
     Panel p;
     p.area = cv::Rect(kLeftMargin, kTopMargin + k * panel_step + kPanelTitleHeight,
                       size.width - kLeftMargin - kRightMargin, panel_step - kPanelTitleHeight - kPanelTickLabelHeight);
-    p.t0 = t0, p.t1 = t1, p.v0 = lo - pad, p.v1 = hi + pad;
+    p.x0 = t0, p.x1 = t1, p.y0 = lo - pad, p.y1 = hi + pad;
     const std::string title =
         std::string(panels[k].name) + " (" + panels[k].unit + ")" +
         (v.empty() ? std::string(": no scored frames") : ", RMSE " + fixed(rmse(v), 3) + " " + panels[k].unit);
@@ -193,13 +103,13 @@ void write_error_plot(const std::string& path, const std::vector<FrameError>& er
   }
   text(image, "time (s)", {kLeftMargin + (size.width - kLeftMargin - kRightMargin) / 2, size.height - 12},
        kTitleFontScale, Align::centre);
-  save(path, image);
+  save_png(path, image);
 }
 
 void write_trajectory_plot(const std::string& path, const std::vector<TruthPose>& truth,
                            const std::vector<EstimateRecord>& estimates, const std::vector<FrameError>& errors,
                            const std::vector<Polyline2d>& background, const PlotSize& size) {
-  check_size(path, size);
+  check_size(path, size.width, size.height);
   cv::Mat image(size.height, size.width, CV_8UC3, kWhite);
 
   // Frame the trajectories (not the background, which may be a whole map).
@@ -294,7 +204,7 @@ void write_trajectory_plot(const std::string& path, const std::vector<TruthPose>
   text(image, title, {kMapMargin, kMapMargin - 15}, kTitleFontScale);
   text(image, "thin lines: truth (grey), estimate (dark grey); green circle: start",
        {kMapMargin, size.height - kMapMargin / 2 + 5});
-  save(path, image);
+  save_png(path, image);
 }
 
 }  // namespace lidarloop

@@ -16,6 +16,7 @@
 #include "loop/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "loop/run_recording.hpp"
+#include "loop/sweep_plan.hpp"
 #include "sim/sensor_calibration.hpp"
 #include "tools/commands.hpp"
 #include "tools/scene_setup.hpp"
@@ -26,7 +27,6 @@ namespace {
 // A scan "has an obstacle in the corridor" with at least this many obstacle points (a pedestrian at
 // 30 m gives a few dozen; stray returns a handful).
 constexpr size_t kObstacleScanPoints = 20;
-constexpr size_t kMaxSeeds = 100;  // --seeds: a typo's guard, not a limit of the method
 
 // The scenario named on the command line, with --seed and --duration applied.
 LoadedScenario load_with_overrides(const Args& args) {
@@ -181,26 +181,6 @@ std::vector<Metrics> compare_once(const LoadedScenario& s, const std::vector<std
   return metrics;
 }
 
-// --seeds: "1,2,5" or "1-5".
-std::vector<uint64_t> parse_seeds(const std::string& text) {
-  std::vector<uint64_t> seeds;
-  const size_t dash = text.find('-');
-  try {
-    if (dash != std::string::npos) {
-      const uint64_t first = std::stoull(text.substr(0, dash)), last = std::stoull(text.substr(dash + 1));
-      if (last < first || last - first >= kMaxSeeds) throw std::invalid_argument("range");
-      for (uint64_t k = first; k <= last; ++k) seeds.push_back(k);
-    } else {
-      std::stringstream ss(text);
-      for (std::string item; std::getline(ss, item, ',');) seeds.push_back(std::stoull(item));
-    }
-  } catch (const std::exception&) {
-    throw InputError("--seeds: expected a list like 1,2,3 or a range like 1-5, got '" + text + "'");
-  }
-  if (seeds.empty() || seeds.size() > kMaxSeeds) throw InputError("--seeds: give 1 to 100 seeds");
-  return seeds;
-}
-
 int run_compare(const Args& args) {
   const int threads = thread_count(args);
   const auto limit = limit_threads(threads);
@@ -231,7 +211,7 @@ int run_compare(const Args& args) {
   // Several seeds: one drive each, then every method's mean and spread over them.
   std::vector<Metrics> all;
   int status = 0;
-  for (const uint64_t seed : parse_seeds(*args.value("seeds"))) {
+  for (const uint64_t seed : parse_seed_list(*args.value("seeds"), "--seeds")) {
     s.scenario.seed = seed;
     size_t scans = 0;
     const std::vector<Metrics> metrics =
