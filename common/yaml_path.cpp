@@ -31,6 +31,7 @@ std::vector<YamlPathStep> parse_yaml_path(const std::string& path) {
       size_t end = i;
       while (end < path.size() && path[end] != '.' && path[end] != '[') ++end;
       if (end == i) throw bad("an empty key");
+      if (path.substr(i, end - i).find(']') != std::string::npos) throw bad("a stray ']'");
       steps.emplace_back(path.substr(i, end - i));
       i = end;
     }
@@ -47,7 +48,8 @@ YAML::Node yaml_node_at(YAML::Node root, const std::string& path) {
       if (node.IsDefined() && !node.IsMap() && !node.IsNull())
         throw InputError(path + ": '" + (walked.empty() ? "the scenario" : walked) + "' is not a mapping");
       node.reset(node[*key]);
-      walked += (walked.empty() ? "" : ".") + *key;
+      if (!walked.empty()) walked += '.';
+      walked += *key;
     } else {
       const size_t index = std::get<size_t>(step);
       if (!node.IsSequence())
@@ -56,7 +58,9 @@ YAML::Node yaml_node_at(YAML::Node root, const std::string& path) {
         throw InputError(path + ": '" + walked + "' has " + std::to_string(node.size()) + " entries, no [" +
                          std::to_string(index) + "]");
       node.reset(node[index]);
-      walked += "[" + std::to_string(index) + "]";
+      walked += '[';
+      walked += std::to_string(index);
+      walked += ']';
     }
   }
   return node;

@@ -215,7 +215,7 @@ SweepSpec load_sweep(const std::string& path) {
   for (size_t k = 0; k < spec.methods.size(); ++k) {
     try {
       parse_localizer_method(spec.methods[k]);
-    } catch (const InputError& e) {
+    } catch (const std::exception& e) {
       y.fail(top["methods"][k], e.what());
     }
   }
@@ -401,8 +401,10 @@ std::string sweep_digest(const SweepSpec& spec) {
 Shard parse_shard(const std::string& text) {
   const size_t slash = text.find('/');
   try {
-    if (slash == std::string::npos || text.find_first_not_of("0123456789/") != std::string::npos)
-      throw std::invalid_argument(text);
+    const std::string index = text.substr(0, slash == std::string::npos ? 0 : slash);
+    const std::string count = slash == std::string::npos ? "" : text.substr(slash + 1);
+    for (const std::string* part : {&index, &count})
+      if (part->empty() || part->find_first_not_of("0123456789") != std::string::npos) throw std::invalid_argument(text);
     const Shard s{std::stoul(text.substr(0, slash)), std::stoul(text.substr(slash + 1))};
     if (s.count == 0 || s.index >= s.count) throw std::invalid_argument(text);
     return s;
