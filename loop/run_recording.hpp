@@ -42,6 +42,10 @@ class TeeSink : public StreamSink {
     a_.on_actors(stamp_ns, actors);
     if (b_) b_->on_actors(stamp_ns, actors);
   }
+  void on_curb_visibility(const CurbVisibility& v) override {
+    a_.on_curb_visibility(v);
+    if (b_) b_->on_curb_visibility(v);
+  }
 
  private:
   StreamSink& a_;

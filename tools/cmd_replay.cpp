@@ -78,6 +78,7 @@ int run_replay(const Args& args) {
     pending.reset();
   };
   size_t scans = 0;
+  std::vector<CurbVisibility> curb_visibility;
   for (; more; more = reader.next(message)) {
     const std::string& topic = message.channel->topic;
     const std::string context = log + " " + topic;
@@ -108,7 +109,7 @@ int run_replay(const Args& args) {
   const std::string name = std::filesystem::path(run.scenario_name).stem().string();
   const std::string out = args.text("out", "out/" + name + "-replay");
   const ScoredRun scored = score_and_write(out, name, scenario, resolved.ego_route, truth, method_name(params.method),
-                                           estimates, nullptr, map);
+                                           estimates, nullptr, map, curb_visibility);
   std::cout << comparison_markdown({scored.metrics});
   std::printf("\nlog        %s (%zu scans, seed %llu, recorded with %s)\n", log.c_str(), scans,
               (unsigned long long)scenario.seed, recorded_method.empty() ? "no localizer" : recorded_method.c_str());
