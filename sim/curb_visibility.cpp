@@ -1,6 +1,5 @@
 #include "sim/curb_visibility.hpp"
 
-#include <algorithm>
 #include <string>
 
 #include "sim/curb_band.hpp"

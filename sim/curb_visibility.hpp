@@ -24,15 +24,15 @@ struct CurbVisibilityConfig {
   // kMinRange, about the sensor's own minimum range: localizer/curb_detector.cpp) to 25 m
   // (CurbDetectorParams::max_range in localizer/curb_detector.hpp: beyond, the rings are too far apart
   // to show a curb). A curb outside that is not the localizer's loss, hidden or not. (The detector
-  // measures from the rear axle, 1.2 m behind the LiDAR: the band is the same width.)
+  // measures from the rear axle, 1.2 m behind the LiDAR; measured from the LiDAR here, the disc is as
+  // large, a little further ahead.)
   double min_range_m = 1.0, max_range_m = 25.0;
   // Along each curb line. The detector needs a rise within 0.40 m of ring (CurbDetectorParams::
   // step_length), so every stretch that could give a detection holds a sample; two curbs of a straight
   // road within 25 m are then ~400 rays, under 1 % of a scan's ~70k.
   double spacing_m = 0.25;
   // Rays stop this short of their sample, so the curb's own surfaces at the sample (float mesh) are not
-  // in the way. Under the gap between an actor and the curb it stands by (a parked bus's wheels are
-  // 0.2-0.5 m from the curb).
+  // in the way; well under the gap a vehicle leaves to the curb, so an actor beside it still counts.
   double stop_short_m = 0.05;
 };
 

@@ -1,6 +1,7 @@
 // lidarloop run / compare: a scenario with the localizer in the loop, scored against ground truth.
 #include <unistd.h>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -242,7 +243,8 @@ int run_compare(const Args& args) {
     std::printf("seed %-5llu %zu scans:", (unsigned long long)seed, scans);
     for (const Metrics& m : metrics)
       std::printf(" %s %.3f/%.3f/%.3f", m.method.c_str(), m.lateral_rmse_m, m.longitudinal_rmse_m, m.heading_rmse_deg);
-    if (!metrics.empty()) std::printf("; curbs hidden %.1f%%", 100 * metrics.front().curb_hidden_fraction);
+    if (!metrics.empty() && std::isfinite(metrics.front().curb_hidden_fraction))  // the same drive for every method
+      std::printf("; curbs hidden %.1f%%", 100 * metrics.front().curb_hidden_fraction);
     std::printf("\n");
     if (expect && expect_best(metrics, *expect) != 0) status = 1;
   }
