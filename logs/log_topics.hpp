@@ -13,6 +13,7 @@
 //   /truth/state          lidarloop_msgs/msg/TruthState     map (lossless: replay scores against it)
 //   /truth/actors         lidarloop_msgs/msg/ActorArray     map
 //   /truth/body           geometry_msgs/msg/PoseStamped     base_link (the sprung body's frame on its suspension)
+//   /truth/curb_visibility lidarloop_msgs/msg/CurbVisibility map (the curb the traffic hid, per scan)
 //   /localizer/odometry   nav_msgs/msg/Odometry             map -> base_link_estimate (with covariance)
 //   /tf                   tf2_msgs/msg/TFMessage            map -> base_link (truth), map -> base_link_estimate
 //   /tf_static            tf2_msgs/msg/TFMessage            base_link -> lidar (mount), base_link -> gps
@@ -38,6 +39,7 @@ inline constexpr const char* truth_odometry = "/truth/odometry";
 inline constexpr const char* truth_state = "/truth/state";
 inline constexpr const char* truth_actors = "/truth/actors";
 inline constexpr const char* truth_body = "/truth/body";
+inline constexpr const char* truth_curb_visibility = "/truth/curb_visibility";
 inline constexpr const char* estimate = "/localizer/odometry";
 inline constexpr const char* tf = "/tf";
 inline constexpr const char* tf_static = "/tf_static";

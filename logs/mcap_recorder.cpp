@@ -97,6 +97,11 @@ void McapRecorder::write_actors(int64_t stamp_ns, const std::vector<ros2::ActorS
   write(spec, stamp_ns, ros2::encode_actor_array(stamp_ns, actors, t::map_frame));
 }
 
+void McapRecorder::write_curb_visibility(const CurbVisibility& visibility) {
+  static constexpr ChannelSpec spec{t::truth_curb_visibility, "lidarloop_msgs/msg/CurbVisibility"};
+  write(spec, visibility.stamp_ns, ros2::encode_curb_visibility(visibility));
+}
+
 void McapRecorder::write_estimate(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& cov_xy_yaw) {
   static constexpr ChannelSpec odometry{t::estimate, "nav_msgs/msg/Odometry"};
   static constexpr ChannelSpec tf{t::tf, "tf2_msgs/msg/TFMessage"};

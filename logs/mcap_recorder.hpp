@@ -32,6 +32,7 @@ class McapRecorder {
   void write_rtk(const GpsFix& fix);
   void write_scan(const PointCloud& cloud);
   void write_actors(int64_t stamp_ns, const std::vector<ros2::ActorState>& actors);
+  void write_curb_visibility(const CurbVisibility& visibility);
 
   // The localizer's estimate: /localizer/odometry (covariance of x, y, yaw) and /tf.
   void write_estimate(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& cov_xy_yaw);

@@ -330,6 +330,21 @@ TruthSample decode_truth_state(View cdr, const std::string& context) {
   return t;
 }
 
+Bytes encode_curb_visibility(const CurbVisibility& v) {
+  CdrWriter w;
+  header(w, v.stamp_ns, "map");
+  for (int n : {v.visible, v.hidden, v.blocked_by_world}) w.i32(n);
+  return std::move(w.buffer());
+}
+
+CurbVisibility decode_curb_visibility(View cdr, const std::string& context) {
+  CdrReader r(cdr, context);
+  CurbVisibility v;
+  v.stamp_ns = header(r);
+  for (int* n : {&v.visible, &v.hidden, &v.blocked_by_world}) *n = r.i32();
+  return v;
+}
+
 Odometry planar_odometry(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& cov_xy_yaw,
                          const std::string& frame_id, const std::string& child_frame_id) {
   Odometry o;

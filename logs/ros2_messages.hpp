@@ -25,6 +25,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/curb_visibility.hpp"
 #include "common/point_cloud.hpp"
 #include "common/vehicle_messages.hpp"
 
@@ -70,6 +71,10 @@ CanFrame decode_vehicle_report(View cdr, const std::string& context);
 // lidarloop_msgs/msg/TruthState (frame map).
 Bytes encode_truth_state(const TruthSample& truth);
 TruthSample decode_truth_state(View cdr, const std::string& context);
+
+// lidarloop_msgs/msg/CurbVisibility (frame map).
+Bytes encode_curb_visibility(const CurbVisibility& v);
+CurbVisibility decode_curb_visibility(View cdr, const std::string& context);
 
 // nav_msgs/msg/Odometry.
 struct Odometry {

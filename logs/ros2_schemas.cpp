@@ -137,6 +137,13 @@ const std::map<std::string, std::string>& definitions() {
        "float64 x                        # m, map frame\n"
        "float64 y                        # m\n"
        "float64 yaw                      # rad\n"},
+      {"lidarloop_msgs/CurbVisibility",
+       "# Simulator ground truth: how much of the curb within the localizer's curb range (1-25 m) the traffic\n"
+       "# hid from the LiDAR at a scan's first firing (header.stamp), counted in curb-top samples 0.25 m apart.\n"
+       "std_msgs/Header header\n"
+       "int32 visible                    # samples the LiDAR sees\n"
+       "int32 hidden                     # in sight of the static world, but an actor is in the way\n"
+       "int32 blocked_by_world           # out of sight of the static world alone: in neither count\n"},
       {"lidarloop_msgs/ActorArray",
        "# Simulator ground truth of the traffic actors, at each LiDAR scan's stamp.\n"
        "std_msgs/Header header\n"

@@ -98,6 +98,9 @@ class PipelinedSink : public StreamSink {
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override {
     hold([this, stamp_ns, actors] { also_->on_actors(stamp_ns, actors); });
   }
+  void on_curb_visibility(const CurbVisibility& v) override {
+    hold([this, v] { also_->on_curb_visibility(v); });
+  }
   void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
     release_previous_scan();
     if (also_) also_->on_scan(cloud, sensor_pose);
@@ -259,10 +262,10 @@ class DelayedPose {
 // the scorer, the scan count, and the CAN frames the controller's dead reckoning needs.
 class SimulationTap : public StreamSink {
  public:
-  SimulationTap(StreamSink& next, std::vector<TruthSample>& truth, size_t& scans, DelayedPose* controller_pose)
-      : next_(next), truth_(truth), scans_(scans), controller_pose_(controller_pose) {}
+  SimulationTap(StreamSink& next, LoopResult& result, DelayedPose* controller_pose)
+      : next_(next), result_(result), controller_pose_(controller_pose) {}
   void on_truth(const TruthSample& t) override {
-    truth_.push_back(t);
+    result_.truth.push_back(t);
     next_.on_truth(t);
   }
   void on_can(const CanFrame& f) override {
@@ -273,14 +276,17 @@ class SimulationTap : public StreamSink {
   void on_rtk(const GpsFix& f) override { next_.on_rtk(f); }
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& a) override { next_.on_actors(stamp_ns, a); }
   void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
-    ++scans_;
+    ++result_.scans;
     next_.on_scan(cloud, sensor_pose);
+  }
+  void on_curb_visibility(const CurbVisibility& v) override {
+    result_.curb_visibility.push_back(v);
+    next_.on_curb_visibility(v);
   }
 
  private:
   StreamSink& next_;
-  std::vector<TruthSample>& truth_;
-  size_t& scans_;
+  LoopResult& result_;  // only the fields above: the localizers' thread writes the others
   DelayedPose* controller_pose_;
 };
 
@@ -301,7 +307,7 @@ LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<Loc
   const auto t0 = Clock::now();
   {
     PipelinedSink sink(localizers, also, handed_out);
-    SimulationTap tap(sink, result.truth, result.scans, controller_pose ? &*controller_pose : nullptr);
+    SimulationTap tap(sink, result, controller_pose ? &*controller_pose : nullptr);
     if (controller_pose)
       sim.set_pose_source([&](int64_t t_ns, const Pose2d& truth) { return controller_pose->pose(t_ns, truth); });
     sim.run(tap, progress);

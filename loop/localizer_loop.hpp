@@ -30,6 +30,7 @@ struct MethodTrace {
 
 struct LoopResult {
   std::vector<TruthSample> truth;
+  std::vector<CurbVisibility> curb_visibility;  // one per scan, as the simulator measured it
   std::vector<MethodTrace> methods;
   double wall_s = 0;            // whole loop
   double localizer_wall_s = 0;  // inside the localizers

@@ -135,6 +135,8 @@ std::string metrics_json(const Metrics& m) {
       {"latency_p99_ms", finite_or_null(m.latency_p99_ms)},
       {"latency_max_ms", finite_or_null(m.latency_max_ms)},
       {"max_lane_offset_m", finite_or_null(m.max_lane_offset_m)},
+      {"curb_hidden_fraction", finite_or_null(m.curb_hidden_fraction)},
+      {"curb_hidden_fraction_max", finite_or_null(m.curb_hidden_fraction_max)},
       {"thresholds",
        {{"lateral_rmse_m", optional_or_null(m.thresholds.lateral_rmse_m)},
         {"longitudinal_rmse_m", optional_or_null(m.thresholds.longitudinal_rmse_m)},
@@ -146,6 +148,12 @@ std::string metrics_json(const Metrics& m) {
       {"failures", m.failures},
   };
   return doc.dump(kJsonIndent) + "\n";
+}
+
+std::string curb_occlusion_text(const Metrics& m) {
+  if (!std::isfinite(m.curb_hidden_fraction)) return "no curb sample in range in any scan (or not measured)";
+  return "the traffic hid " + format("%.1f", 100 * m.curb_hidden_fraction) +
+         "% of the curb samples in range (worst scan " + format("%.1f", 100 * m.curb_hidden_fraction_max) + "%)";
 }
 
 void write_metrics_json(const std::string& path, const Metrics& metrics) {

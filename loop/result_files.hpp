@@ -39,4 +39,8 @@ std::string comparison_markdown(const std::vector<Metrics>& runs);
 // The same columns (and always the scenario) with full precision.
 void write_comparison_csv(const std::string& path, const std::vector<Metrics>& runs);
 
+// For people: how much of the curb the traffic hid over the run and in its worst scan, e.g.
+// "the traffic hid 12.3% of the curb samples in range (worst scan 45.6%)".
+std::string curb_occlusion_text(const Metrics& m);
+
 }  // namespace lidarloop

@@ -51,10 +51,10 @@ std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthSample>& truth_samples, const std::string& method,
                           const std::vector<LocalizerEstimate>& all_estimates, const WorstFrame* worst,
-                          const HdMap& map) {
+                          const HdMap& map, const std::vector<CurbVisibility>& curb_visibility) {
   const std::vector<EstimateRecord> estimates = estimate_records(all_estimates);
   const std::vector<TruthPose> truth = truth_poses(truth_samples);
-  ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name);
+  ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name, curb_visibility);
   scored.metrics.realism = realism_name(scenario.realism);
   scored.metrics.realism_overrides = realism_overrides(scenario);
   const MountDraw mount = draw_mount_error(scenario.mount_error, scenario.seed);  // as the simulation drew it

@@ -18,9 +18,10 @@ std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate
 
 // Scores one method's run with the pure scorer (loop/scorer.hpp: the thresholds and settle time from
 // the scenario, lane keeping along `route`), then writes its files into `dir`. `worst` may be null (no
-// bird's-eye picture).
+// bird's-eye picture). `curb_visibility`: the simulator's per-scan records (empty when not known).
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthSample>& truth, const std::string& method,
-                          const std::vector<LocalizerEstimate>& estimates, const WorstFrame* worst, const HdMap& map);
+                          const std::vector<LocalizerEstimate>& estimates, const WorstFrame* worst, const HdMap& map,
+                          const std::vector<CurbVisibility>& curb_visibility);
 
 }  // namespace lidarloop

@@ -42,6 +42,10 @@ class TeeSink : public StreamSink {
     a_.on_actors(stamp_ns, actors);
     if (b_) b_->on_actors(stamp_ns, actors);
   }
+  void on_curb_visibility(const CurbVisibility& v) override {
+    a_.on_curb_visibility(v);
+    if (b_) b_->on_curb_visibility(v);
+  }
 
  private:
   StreamSink& a_;
@@ -59,6 +63,7 @@ class RecordingSink : public StreamSink {
   // The sensor pose is not logged separately: /tf (truth) and /tf_static (mount) give it.
   void on_scan(const PointCloud& c, const Eigen::Isometry3d&) override { log_.write_scan(c); }
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override;
+  void on_curb_visibility(const CurbVisibility& v) override { log_.write_curb_visibility(v); }
 
   McapRecorder& log() { return log_; }
 

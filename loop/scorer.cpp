@@ -97,8 +97,24 @@ std::vector<double> lane_offsets(const std::vector<TruthPose>& truth, const Path
   return offsets;
 }
 
+CurbOcclusion curb_occlusion(const std::vector<CurbVisibility>& scans) {
+  CurbOcclusion o;
+  int64_t hidden = 0, in_sight = 0;  // in sight: of the static world, so hidden or visible
+  for (const CurbVisibility& v : scans) {
+    const int scan_in_sight = v.hidden + v.visible;
+    if (scan_in_sight == 0) continue;
+    hidden += v.hidden;
+    in_sight += scan_in_sight;
+    const double fraction = double(v.hidden) / double(scan_in_sight);
+    if (!(fraction <= o.hidden_fraction_max)) o.hidden_fraction_max = fraction;  // NaN at first
+  }
+  if (in_sight > 0) o.hidden_fraction = double(hidden) / double(in_sight);
+  return o;
+}
+
 ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates, const Path& route,
-                const PassThresholds& thresholds, const std::string& method, const std::string& scenario) {
+                const PassThresholds& thresholds, const std::string& method, const std::string& scenario,
+                const std::vector<CurbVisibility>& curb_visibility) {
   if (!std::is_sorted(truth.begin(), truth.end(),
                       [](const TruthPose& a, const TruthPose& b) { return a.stamp_ns < b.stamp_ns; }))
     throw std::invalid_argument("score: ground truth is not sorted by stamp");
@@ -158,6 +174,9 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
   for (double offset : lane_offsets(truth, route)) lane_offset = std::max(lane_offset, std::abs(offset));
   m.max_lane_offset_m = lane_offset;
   check(m, "lane offset", m.max_lane_offset_m, thresholds.max_lane_offset_m, "m");
+  const CurbOcclusion occlusion = curb_occlusion(curb_visibility);
+  m.curb_hidden_fraction = occlusion.hidden_fraction;
+  m.curb_hidden_fraction_max = occlusion.hidden_fraction_max;
   m.pass = m.failures.empty();
   return run;
 }

@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 
+#include "common/curb_visibility.hpp"
 #include "common/vehicle_messages.hpp"
 #include "sim/path.hpp"
 #include "sim/scenario.hpp"
@@ -39,6 +40,9 @@ struct EstimateRecord {
   std::string status;                                    // the method's own word ("tracking", "gps only", ...)
   double latency_ms = 0;                                 // wall time the localizer spent on this frame
 };
+
+// And, for the run's occlusion, the simulator's per-scan curb visibility (common/curb_visibility.hpp):
+// measured in the true scene, only summed here.
 
 // ---- What comes out ----
 
@@ -66,6 +70,11 @@ struct Metrics {
   double latency_p50_ms = 0, latency_p99_ms = 0, latency_max_ms = 0;  // over every estimate
   // The truth's largest distance from the route (its lane's centre) over the whole run; NaN without truth.
   double max_lane_offset_m = std::numeric_limits<double>::quiet_NaN();
+  // How much of the curb in the localizer's range the traffic hid: hidden / (hidden + visible) curb
+  // samples over every scan of the run, and the worst scan's. NaN when no sample was ever in range (or
+  // the run's visibility is not known, as in a replayed log without it).
+  double curb_hidden_fraction = std::numeric_limits<double>::quiet_NaN();
+  double curb_hidden_fraction_max = std::numeric_limits<double>::quiet_NaN();
   PassThresholds thresholds;
   bool pass = false;
   std::vector<std::string> failures;  // for people, e.g. "lateral RMSE 0.310 m > 0.200 m"
@@ -83,9 +92,11 @@ struct ScoredRun {
 // and measures the truth's lane keeping along `route`. `method` and `scenario` only label the metrics.
 // Passes when there is at least one scored frame and every threshold that is set holds (a non-finite
 // value never holds). Throws std::invalid_argument if the truth is not sorted by stamp or the route
-// has fewer than two points.
+// has fewer than two points. `curb_visibility` (one record per scan, any order) gives the curb
+// occlusion figures; it is not scored against any threshold.
 ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates, const Path& route,
-                const PassThresholds& thresholds, const std::string& method, const std::string& scenario);
+                const PassThresholds& thresholds, const std::string& method, const std::string& scenario,
+                const std::vector<CurbVisibility>& curb_visibility = {});
 
 // ---- Its parts, pure as well ----
 
@@ -105,6 +116,13 @@ Pose2d truth_at(const std::vector<TruthPose>& truth, int64_t t_ns);
 // is projected onto the whole route. Throws std::invalid_argument if the route has fewer than two
 // points.
 std::vector<double> lane_offsets(const std::vector<TruthPose>& truth, const Path& route);
+
+// The curb occlusion of a run (Metrics::curb_hidden_fraction and _max) from its per-scan records.
+struct CurbOcclusion {
+  double hidden_fraction = std::numeric_limits<double>::quiet_NaN();
+  double hidden_fraction_max = std::numeric_limits<double>::quiet_NaN();  // over scans with a sample in range
+};
+CurbOcclusion curb_occlusion(const std::vector<CurbVisibility>& scans);
 
 // Root mean square; NaN for an empty list (there is nothing to measure, and 0 would read as perfect).
 double rmse(const std::vector<double>& values);

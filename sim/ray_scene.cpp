@@ -22,6 +22,7 @@ RayScene::RayScene(const TriangleMesh& world, int threads) {
   prototypes_.push_back(make_prototype(world));
   add_actor(0, Eigen::Isometry3d::Identity());
   actors_.clear();  // the world's instance is not an actor
+  instances_.front().actor = -1;
   commit();
 }
 
@@ -62,7 +63,7 @@ int RayScene::add_actor(int prototype, const Eigen::Isometry3d& pose) {
   RTCGeometry inst = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
   rtcSetGeometryInstancedScene(inst, prototypes_[prototype].scene);
   const unsigned geom_id = rtcAttachGeometry(top_, inst);
-  instances_.push_back({prototype, inst, geom_id, {}, true});
+  instances_.push_back({prototype, inst, geom_id, {}, true, int(actors_.size())});
   if (instance_of_geom_.size() <= geom_id) instance_of_geom_.resize(geom_id + 1, -1);
   instance_of_geom_[geom_id] = int(instances_.size()) - 1;
   actors_.push_back(int(instances_.size()) - 1);
@@ -106,7 +107,7 @@ RayHit RayScene::make_hit(unsigned inst_id, unsigned prim_id, float tfar, const 
   // Embree reports instanced normals in the instance's object space; the nearest keyframe's
   // rotation is close enough for an incidence angle.
   const size_t k = size_t(std::lround(time * float(inst.rotations.size() - 1)));
-  return {tfar, (inst.rotations[k] * ng).normalized(), prototypes_[inst.prototype].materials[prim_id]};
+  return {tfar, (inst.rotations[k] * ng).normalized(), prototypes_[inst.prototype].materials[prim_id], inst.actor};
 }
 
 bool RayScene::intersect(const Ray& ray, float tnear, float tfar, RayHit& hit) const {
@@ -123,6 +124,19 @@ bool RayScene::intersect(const Ray& ray, float tnear, float tfar, RayHit& hit) c
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit = make_hit(rh.hit.instID[0], rh.hit.primID, rh.ray.tfar, {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, ray.time);
   return true;
+}
+
+bool RayScene::world_occludes(const Ray& ray, float tnear, float tfar) const {
+  // The world's instance has the identity transform, so its own BVH is the world alone.
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay r;
+  r.org_x = ray.origin.x(), r.org_y = ray.origin.y(), r.org_z = ray.origin.z();
+  r.dir_x = ray.direction.x(), r.dir_y = ray.direction.y(), r.dir_z = ray.direction.z();
+  r.tnear = tnear, r.tfar = tfar, r.time = 0;
+  r.mask = std::numeric_limits<unsigned>::max(), r.id = 0, r.flags = 0;
+  rtcOccluded1(prototypes_.front().scene, &context, &r);
+  return r.tfar < 0;  // Embree marks an occluded ray with tfar = -inf
 }
 
 void RayScene::intersect8(const Ray* rays, int count, float tnear, float tfar, RayHit* hits, bool* found) const {

@@ -26,6 +26,7 @@ struct RayHit {
   float range = 0;                  // along the (unit) ray direction
   Eigen::Vector3f normal{0, 0, 1};  // unit, world frame
   MaterialId material = 0;
+  int actor = -1;  // the actor hit (add_actor's id), -1 for the static world
 };
 
 class RayScene {
@@ -53,6 +54,9 @@ class RayScene {
   // found[k] tells whether ray k hit; hits[k] is set only then.
   static constexpr int kPacket = 16;
   void intersect8(const Ray* rays, int count, float tnear, float tfar, RayHit* hits, bool* found) const;
+  // Whether the static world alone (no actors) stops the ray within [tnear, tfar]: what a ray that
+  // met an actor would have met without the traffic.
+  bool world_occludes(const Ray& ray, float tnear, float tfar) const;
 
   RTCScene top_level() const { return top_; }  // for benchmarking bare rtcIntersect1
   size_t world_triangles() const { return world_triangles_; }
@@ -68,6 +72,7 @@ class RayScene {
     unsigned geom_id;
     std::vector<Eigen::Matrix3f> rotations;  // per keyframe, to bring object-space normals to the world
     bool visible;
+    int actor;  // its id, -1 for the static world's instance
   };
   Prototype make_prototype(const TriangleMesh& mesh) const;
   RayHit make_hit(unsigned inst_id, unsigned prim_id, float tfar, const Eigen::Vector3f& ng, float time) const;

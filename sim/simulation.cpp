@@ -49,6 +49,7 @@ Simulation::Simulation(const Scenario& scenario, const WorldDescription& descrip
             plane_under(vehicle_.rear_axle_pose(), pavement_, scenario.ego.vehicle, scenario.body)) {
   add_actors(*scene_, resolved_.actors, actors_dir, materials, ground_);
   actor_poses_ = actor_motion(resolved_.actors, ground_);
+  curb_tops_ = curb_top_samples(world, curb_visibility_.spacing_m);
   trajectory_.push_back(vehicle_.rear_axle_pose());
   body_trajectory_.push_back(body_.attitude());
 }
@@ -128,10 +129,17 @@ void Simulation::emit_scan(StreamSink& sink) {
   PointCloud cloud = scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses_);
   // The LiDAR's clock stamps the scan; the truth (sensor pose, actors) stays on the reference clock.
   cloud.stamp_ns = stamp_on(scenario_.clocks.lidar, stamp, lidar_clock_rng_, uint64_t(scan_index_));
-  sink.on_scan(cloud, vehicle_pose(stamp) * true_lidar_mount_);
+  const Eigen::Isometry3d sensor_pose = vehicle_pose(stamp) * true_lidar_mount_;
+  sink.on_scan(cloud, sensor_pose);
   std::vector<ActorSample> states;
   for (const auto& a : resolved_.actors) states.push_back({a.name, a.type, actor_pose2d(a, stamp)});
   sink.on_actors(stamp, states);
+  // The scene still holds this scan's actor keyframes, so ray time 0 is the scan's first firing: the
+  // instant of the sensor pose and the actors above.
+  CurbVisibility curbs =
+      curb_visibility(*scene_, curb_tops_, sensor_pose.translation().cast<float>(), 0, curb_visibility_);
+  curbs.stamp_ns = stamp;
+  sink.on_curb_visibility(curbs);
   ++scan_index_;
   trajectory_.erase(trajectory_.begin(), trajectory_.end() - 1);
   body_trajectory_.erase(body_trajectory_.begin(), body_trajectory_.end() - 1);

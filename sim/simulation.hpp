@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "common/curb_visibility.hpp"
 #include "common/point_cloud.hpp"
+#include "sim/curb_visibility.hpp"
 #include "sim/lidar_scanner.hpp"
 #include "sim/scenario.hpp"
 #include "sim/vehicle_body.hpp"
@@ -31,6 +33,9 @@ class StreamSink {
   // scan's first firing on the reference clock; the cloud's stamp is the LiDAR clock's (sim/clocks.hpp).
   virtual void on_scan(const PointCloud&, const Eigen::Isometry3d& /*sensor_pose*/) {}
   virtual void on_actors(int64_t /*stamp_ns*/, const std::vector<ActorSample>&) {}
+  // After each scan: how much of the curb in the localizer's range the traffic hid from the LiDAR at
+  // the scan's first firing (sim/curb_visibility.hpp), stamped on the reference clock.
+  virtual void on_curb_visibility(const CurbVisibility&) {}
 };
 
 class Simulation {
@@ -82,6 +87,8 @@ class Simulation {
   std::vector<Pose2d> trajectory_;             // rear-axle pose at every step of the scan being recorded
   std::vector<BodyAttitude> body_trajectory_;  // the body on the ground plane at the same steps
   int64_t trajectory_start_ns_ = 0;
+  CurbVisibilityConfig curb_visibility_;
+  std::vector<Eigen::Vector3f> curb_tops_;  // the world's curbs, sampled once
 };
 
 }  // namespace lidarloop

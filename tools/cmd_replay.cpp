@@ -1,6 +1,8 @@
 // lidarloop replay: a recorded run's streams, read back from its MCAP log, fed to the localizer in
 // the order they were recorded, and scored against the recorded ground truth. The scenario, seed and
-// method come from the log itself, so the estimates are those of the live run, bit for bit.
+// method come from the log itself, so the estimates are those of the live run, bit for bit. Replay
+// does not simulate: the curb the traffic hid (metrics.json's curb_hidden_fraction) is read from the
+// log's /truth/curb_visibility, as the live run measured it (null for a log without it).
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -78,6 +80,7 @@ int run_replay(const Args& args) {
     pending.reset();
   };
   size_t scans = 0;
+  std::vector<CurbVisibility> curb_visibility;
   for (; more; more = reader.next(message)) {
     const std::string& topic = message.channel->topic;
     const std::string context = log + " " + topic;
@@ -97,6 +100,8 @@ int run_replay(const Args& args) {
       pending = ros2::decode_nav_sat_fix(message.data, context);
     } else if (topic == topics::truth_state) {
       truth.push_back(ros2::decode_truth_state(message.data, context));
+    } else if (topic == topics::truth_curb_visibility) {
+      curb_visibility.push_back(ros2::decode_curb_visibility(message.data, context));
     } else if (topic == topics::scan) {
       estimates.push_back(localizer.on_scan(ros2::decode_point_cloud(message.data, context)));
       ++scans;
@@ -108,10 +113,11 @@ int run_replay(const Args& args) {
   const std::string name = std::filesystem::path(run.scenario_name).stem().string();
   const std::string out = args.text("out", "out/" + name + "-replay");
   const ScoredRun scored = score_and_write(out, name, scenario, resolved.ego_route, truth, method_name(params.method),
-                                           estimates, nullptr, map);
+                                           estimates, nullptr, map, curb_visibility);
   std::cout << comparison_markdown({scored.metrics});
   std::printf("\nlog        %s (%zu scans, seed %llu, recorded with %s)\n", log.c_str(), scans,
               (unsigned long long)scenario.seed, recorded_method.empty() ? "no localizer" : recorded_method.c_str());
+  std::printf("curbs      %s\n", curb_occlusion_text(scored.metrics).c_str());
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
       "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "

@@ -1,6 +1,7 @@
 // lidarloop run / compare: a scenario with the localizer in the loop, scored against ground truth.
 #include <unistd.h>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -97,7 +98,7 @@ int run_run(const Args& args) {
 
   const MethodTrace& trace = r.methods.front();
   const ScoredRun scored = score_and_write(out, name, s.scenario, sim.resolved().ego_route, r.truth, trace.method,
-                                           trace.estimates, &trace.worst, map);
+                                           trace.estimates, &trace.worst, map, r.curb_visibility);
   const double lane_offset = scored.metrics.max_lane_offset_m;
   std::cout << comparison_markdown({scored.metrics});
   std::printf("\nscenario   %s (seed %llu, %s loop), %.1f s simulated in %.1f s wall (%.1fx real time, %d thread(s))\n",
@@ -111,6 +112,7 @@ int run_run(const Args& args) {
   for (const auto& e : trace.estimates) with_obstacles += e.obstacle_points >= kObstacleScanPoints;
   std::printf("obstacles  in the corridor in %zu of %zu scans (%.0f%%)\n", with_obstacles, trace.estimates.size(),
               100.0 * double(with_obstacles) / double(std::max<size_t>(trace.estimates.size(), 1)));
+  std::printf("curbs      %s\n", curb_occlusion_text(scored.metrics).c_str());
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
       "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
@@ -173,7 +175,7 @@ std::vector<Metrics> compare_once(const LoadedScenario& s, const std::vector<std
   std::vector<Metrics> metrics;
   for (const auto& trace : r.methods)
     metrics.push_back(score_and_write(out + "/" + trace.method, name, s.scenario, sim.resolved().ego_route, r.truth,
-                                      trace.method, trace.estimates, &trace.worst, map)
+                                      trace.method, trace.estimates, &trace.worst, map, r.curb_visibility)
                           .metrics);
   write_junit(out + "/junit.xml", metrics);
   write_comparison_csv(out + "/comparison.csv", metrics);
@@ -204,6 +206,7 @@ int run_compare(const Args& args) {
                 s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.duration_s, scans,
                 metrics.size());
     print_realism(s.scenario);
+    if (!metrics.empty()) std::printf("curbs      %s\n", curb_occlusion_text(metrics.front()).c_str());  // one drive
     std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, <method>/...)\n", out.c_str());
     return expect ? expect_best(metrics, *expect) : 0;
   }
@@ -220,6 +223,8 @@ int run_compare(const Args& args) {
     std::printf("seed %-5llu %zu scans:", (unsigned long long)seed, scans);
     for (const Metrics& m : metrics)
       std::printf(" %s %.3f/%.3f/%.3f", m.method.c_str(), m.lateral_rmse_m, m.longitudinal_rmse_m, m.heading_rmse_deg);
+    if (!metrics.empty() && std::isfinite(metrics.front().curb_hidden_fraction))  // the same drive for every method
+      std::printf("; curbs hidden %.1f%%", 100 * metrics.front().curb_hidden_fraction);
     std::printf("\n");
     if (expect && expect_best(metrics, *expect) != 0) status = 1;
   }

@@ -1,6 +1,6 @@
 # Record a run at one thread and at two: the logs must be byte-identical. Replay the log: the estimates
 # and ground truth must be the live run's exactly, and so must every accuracy figure of metrics.json
-# (latency is wall time and is not compared).
+# (latency is wall time and is not compared), the curb occlusion included (replay reads it from the log).
 # -DLIDARLOOP=... -DSCENARIO=... -DWORKDIR=...
 file(REMOVE_RECURSE ${WORKDIR})
 file(MAKE_DIRECTORY ${WORKDIR})
@@ -31,7 +31,8 @@ foreach(file estimate.tum truth.tum)
 endforeach()
 file(READ ${WORKDIR}/live_1/metrics.json live)
 file(READ ${WORKDIR}/replay/metrics.json replay)
-foreach(key frames lateral_rmse_m longitudinal_rmse_m heading_rmse_deg max_position_error_m pass)
+foreach(key frames lateral_rmse_m longitudinal_rmse_m heading_rmse_deg max_position_error_m curb_hidden_fraction
+            curb_hidden_fraction_max pass)
   string(JSON a GET "${live}" ${key})
   string(JSON b GET "${replay}" ${key})
   if(NOT a STREQUAL b)

@@ -177,6 +177,17 @@ TEST(Zstd, DecompressionChecksTheDeclaredSize) {
   EXPECT_THROW(zstd_decompress(garbage, data.size(), "test"), InputError);
 }
 
+TEST(Ros2Messages, CurbVisibilityRoundTripsExactly) {
+  const CurbVisibility v{123'456'789'012, 345, 67, 8};
+  const ros2::Bytes bytes = ros2::encode_curb_visibility(v);
+  const CurbVisibility back = ros2::decode_curb_visibility(bytes, "test");
+  EXPECT_EQ(back.stamp_ns, v.stamp_ns);
+  EXPECT_EQ(back.visible, 345);
+  EXPECT_EQ(back.hidden, 67);
+  EXPECT_EQ(back.blocked_by_world, 8);
+  EXPECT_THROW(ros2::decode_curb_visibility(ros2::View(bytes.data(), bytes.size() - 1), "test"), InputError);
+}
+
 TEST(Ros2Messages, PointCloudRoundTripsExactlyAndRejectsBadLayouts) {
   const auto run = test::make_synthetic_run(0.1, 300, 3);
   const PointCloud& cloud = run.scans.at(0);

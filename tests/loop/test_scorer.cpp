@@ -231,6 +231,37 @@ TEST(Score, DivergedEstimateFails) {
   EXPECT_FALSE(m.pass);
 }
 
+TEST(CurbOcclusion, HiddenOverInSightSummedOverScansAndTheWorstScan) {
+  // Scan 2 has 30 of 40 in sight hidden (0.75, the worst); scan 3 has no sample in range and counts
+  // for neither figure; what the static world hid is in neither count.
+  const std::vector<CurbVisibility> scans = {{0, 90, 10, 5}, {100 * kMs, 10, 30, 7}, {200 * kMs, 0, 0, 3}};
+  const CurbOcclusion o = curb_occlusion(scans);
+  EXPECT_DOUBLE_EQ(o.hidden_fraction, 40.0 / 140.0);
+  EXPECT_DOUBLE_EQ(o.hidden_fraction_max, 0.75);
+  // No traffic in the way: exactly 0, not NaN.
+  const CurbOcclusion clear = curb_occlusion({{0, 50, 0, 0}, {100 * kMs, 60, 0, 2}});
+  EXPECT_EQ(clear.hidden_fraction, 0.0);
+  EXPECT_EQ(clear.hidden_fraction_max, 0.0);
+  // Nothing in range, or nothing measured: no fraction at all.
+  EXPECT_TRUE(std::isnan(curb_occlusion({{0, 0, 0, 4}}).hidden_fraction));
+  EXPECT_TRUE(std::isnan(curb_occlusion({}).hidden_fraction_max));
+}
+
+TEST(CurbOcclusion, ScoreCarriesItIntoTheMetricsAndTheirJson) {
+  const Metrics m = score(straight_truth(1), offset_estimates(1, 0, 0, 0), straight_route(), {}, "m", "s",
+                          {{0, 30, 10, 0}, {100 * kMs, 20, 40, 0}})
+                        .metrics;
+  EXPECT_DOUBLE_EQ(m.curb_hidden_fraction, 0.5);
+  EXPECT_DOUBLE_EQ(m.curb_hidden_fraction_max, 40.0 / 60.0);
+  const auto j = nlohmann::json::parse(metrics_json(m));
+  EXPECT_DOUBLE_EQ(j["curb_hidden_fraction"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(j["curb_hidden_fraction_max"].get<double>(), 40.0 / 60.0);
+  EXPECT_EQ(curb_occlusion_text(m), "the traffic hid 50.0% of the curb samples in range (worst scan 66.7%)");
+  const auto unknown = nlohmann::json::parse(metrics_json(score({}, {}, straight_route(), {}, "gps", "s").metrics));
+  EXPECT_TRUE(unknown["curb_hidden_fraction"].is_null());
+  EXPECT_TRUE(unknown["curb_hidden_fraction_max"].is_null());
+}
+
 TEST(ResultFiles, MetricsJsonRoundTrip) {
   PassThresholds t;
   t.lateral_rmse_m = 0.1;

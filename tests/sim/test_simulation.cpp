@@ -15,11 +15,13 @@ struct Recorder : StreamSink {
   std::vector<CanFrame> can;
   std::vector<GpsFix> gps, rtk;
   std::vector<std::pair<PointCloud, Eigen::Isometry3d>> scans;
+  std::vector<CurbVisibility> curbs;
   void on_truth(const TruthSample& s) override { truth.push_back(s); }
   void on_can(const CanFrame& f) override { can.push_back(f); }
   void on_gps(const GpsFix& f) override { gps.push_back(f); }
   void on_rtk(const GpsFix& f) override { rtk.push_back(f); }
   void on_scan(const PointCloud& c, const Eigen::Isometry3d& pose) override { scans.emplace_back(c, pose); }
+  void on_curb_visibility(const CurbVisibility& v) override { curbs.push_back(v); }
 };
 
 // Runs a scenario given as YAML on a world given by name or as YAML text.
@@ -68,6 +70,7 @@ traffic:
 )",
                                 world);
   ASSERT_EQ(rec.scans.size(), 140u);
+  ASSERT_EQ(rec.curbs.size(), rec.scans.size());  // one curb visibility record per scan
   const double right_curb = -3.5, bus_y = -1.75;
   for (size_t k = 0; k < rec.scans.size(); k += 10) {
     const auto& [cloud, sensor] = rec.scans[k];
@@ -82,12 +85,22 @@ traffic:
     const bool alongside = std::abs(bus_x - ego_x) < 3;
     const bool far = std::abs(bus_x - ego_x) > 30;
     SCOPED_TRACE("t = " + std::to_string(t) + " s, bus " + std::to_string(bus_x - ego_x) + " m ahead");
+    const CurbVisibility& v = rec.curbs[k];
+    EXPECT_EQ(v.stamp_ns, int64_t(k) * 100'000'000);  // the scan's start on the reference clock (10 Hz)
+    const double hidden = double(v.hidden) / double(v.hidden + v.visible);
     if (alongside) {
       EXPECT_GT(on_bus, 500);  // the bus is in the scan where it should be
       EXPECT_LT(curb, 10);     // and the right curb beside the ego is hidden
+      // The bus's near side (0.5 m right of the centre line, 2.25 m from the LiDAR) subtends
+      // +-6 m * 5.25 / 2.25 = +-14 m of the right curb (5.25 m away): 112 of the ~195 samples on it
+      // within 25 m, and ~199 on the left curb: 28 % of them all.
+      EXPECT_NEAR(hidden, 0.28, 0.05);
     }
     if (far) {
       EXPECT_GT(curb, 40);  // without the bus the curb face is plain to see
+    }
+    if (std::abs(bus_x - ego_x) > 35) {
+      EXPECT_EQ(v.hidden, 0);  // no ray to a curb in range passes the bus
     }
   }
 }
