@@ -90,6 +90,7 @@ Summary summarise(const std::vector<const Row*>& rows, const std::string& metric
   Summary s;
   std::vector<double> v;
   for (const Row* r : rows) {
+    if (r->status == RunStatus::missing) continue;  // not run yet: neither a run nor a failure
     ++s.runs;
     s.completed += r->outcome != nullptr;
     s.failed += r->failed();
@@ -135,8 +136,9 @@ std::string markdown(const SweepPlan& plan, const std::vector<RunResult>& result
   md << plan.runs.size() << " runs (" << seeds << " seeds; methods " ;
   for (size_t k = 0; k < plan.methods.size(); ++k) md << (k ? ", " : "") << plan.methods[k];
   md << "): " << status_counts(results) << ". A run fails when it misses a threshold of the base scenario's "
-     << "`pass`, or does not finish (error, crash, timeout). Each cell: mean ± standard deviation over the "
-     << "completed runs at that level (all seeds and every level of the other axes).\n";
+     << "`pass`, or does not finish (error, crash, timeout); runs not made yet (missing) are left out. Each "
+     << "cell: mean ± standard deviation over the completed runs at that level (all seeds and every level of "
+     << "the other axes).\n";
   for (const auto& axis : plan.axes)
     for (const auto& method : plan.methods) {
       md << "\n## " << method << " against " << axis.name << "\n\n| " << axis.name << " | runs | failed |";

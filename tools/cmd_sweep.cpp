@@ -240,6 +240,7 @@ int run_sweep(const Args& args) {
   std::printf("; %zu already complete, %zu to run with %d processes of %d thread(s)\n", mine.size() - pending.size(),
               pending.size(), jobs, threads);
   prepare(spec, pending);
+  std::fflush(stdout);  // a pod's or a batch job's log shows what it is doing before the first run ends
 
   std::vector<PoolTask> tasks;
   for (const SweepRun* r : pending) {
@@ -261,6 +262,7 @@ int run_sweep(const Args& args) {
         if (end.status != RunStatus::done) {
           if (terminal) std::printf("\r%80s\r", "");
           std::printf("run %s    %s: %s\n", pending[k]->id.c_str(), run_status_name(end.status), end.detail.c_str());
+          std::fflush(stdout);
         }
       },
       [&](const PoolProgress& p) {

@@ -197,3 +197,29 @@ TEST(SweepReport, OneRowPerRunAndMethodWithWhatIsKnown) {
   const SweepPlan back = read_sweep_plan(path);
   EXPECT_EQ(sweep_csv(back, results), sweep_csv(plan, results));
 }
+
+TEST(SweepReport, FailureRateCountsMissedThresholdsAndUnfinishedRunsNotMissingOnes) {
+  SweepPlan plan;
+  plan.sweep_file = "s.yaml";
+  plan.axes = {SweepAxis{"gap_m", "", {{"0.5", 0.5, {}}}}};
+  plan.methods = {"proposed"};
+  plan.metrics = {"lateral_rmse_m"};
+  for (size_t k = 0; k < 4; ++k) plan.runs.push_back({k, "000" + std::to_string(k), {0}, k, {"proposed"}, ""});
+  std::vector<RunResult> results(4);
+  results[0].end.status = RunStatus::done;
+  results[0].methods["proposed"] = {true, {{"lateral_rmse_m", 0.01}}};
+  results[1].end.status = RunStatus::done;
+  results[1].methods["proposed"] = {false, {{"lateral_rmse_m", 0.03}}};  // missed a threshold
+  results[2].end.status = RunStatus::crashed;
+  // results[3]: missing (a shard not run yet)
+  const fs::path dir = fs::temp_directory_path() / "lidarloop_sweep_report";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write_sweep_report(dir.string(), plan, results);
+  std::ifstream in(dir / "sweep.md");
+  const std::string md((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Three runs ended, two failed; the mean and spread are over the two with metrics.
+  EXPECT_NE(md.find("| 0.5 | 3 | 66.7 % | 0.02 ± 0.014 |"), std::string::npos) << md;
+  EXPECT_TRUE(fs::exists(dir / "plots" / "lateral_rmse_m_vs_gap_m.png"));
+  EXPECT_TRUE(fs::exists(dir / "plots" / "failure_rate_vs_gap_m.png"));
+}
