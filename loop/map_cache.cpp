@@ -26,8 +26,11 @@ namespace fs = std::filesystem;
 
 constexpr uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3ULL;
 // Bump when the mapping drive changes what it produces. 2: the map is a survey (pose error, its own
-// HDL-32E unit, curbs moved by the survey error). 3: the survey car rests on the crowned road.
-constexpr int kMapFormatVersion = 3;
+// HDL-32E unit, curbs moved by the survey error). 3: the survey car rests on the crowned road. 4: lanes
+// are driven in parts of 16 scans, each accumulated on its own and merged into the map with Chan's
+// formula in a fixed order (place, then lane), where one Welford stream ran lane after lane: the same
+// points per cell, means and variances that differ in the last bits (double rounding, then float).
+constexpr int kMapFormatVersion = 4;
 
 static void hash_bytes(uint64_t& h, const std::string& bytes) {
   for (unsigned char c : bytes) h = (h ^ c) * kFnvPrime;
@@ -144,15 +147,21 @@ MapLocation ensure_map(const std::string& world_name, const MappingOptions& opti
   remove_stale_builds(loc.dir);
 
   const auto t0 = std::chrono::steady_clock::now();
-  IntensityMapBuilder builder =
-      run_mapping_drive(w.description, w.world, w.materials, actors_dir(), options, loc.hash, [&](double f) {
+  const std::string tmp = make_build_dir(loc.dir);
+  // Tiles are written as the drive finishes them: memory holds the open ones, not the map.
+  IntensityMapWriter writer(tmp);
+  const IntensityMapHeader header = run_mapping_drive(
+      w.description, w.world, w.materials, actors_dir(), options, loc.hash,
+      [&](const IntensityMapHeader& h, const std::pair<int, int>& key, std::vector<IntensityMoments>& cells) {
+        writer.write_tile(h, key, cells);
+      },
+      [&](double f) {
         if (!terminal) return;
         std::printf("\rmapping %s %3d%%", w.world.name.c_str(), int(f * 100));
         std::fflush(stdout);
       });
   if (terminal) std::printf("\r%40s\r", "");
-  const std::string tmp = make_build_dir(loc.dir);
-  builder.save(tmp);
+  writer.finish(header);
   const SurveyDrive survey = mapping_survey(w.description, options);
   write_curb_map(tmp + "/curbs.geojson", surveyed_curbs(w.world, survey, options));
   write_intensity_pngs(tmp, tmp + "/mean.png", tmp + "/variance.png");
