@@ -29,7 +29,8 @@ constexpr uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3
 // HDL-32E unit, curbs moved by the survey error). 3: the survey car rests on the crowned road. 4: lanes
 // are driven in parts of 16 scans, each accumulated on its own and merged into the map with Chan's
 // formula in a fixed order (place, then lane), where one Welford stream ran lane after lane: the same
-// points per cell, means and variances that differ in the last bits (double rounding, then float).
+// points per cell, means and variances that may differ in the last bit of the stored float (large: 44
+// of its cells' m2 by one ulp; campus: none).
 constexpr int kMapFormatVersion = 4;
 
 static void hash_bytes(uint64_t& h, const std::string& bytes) {
