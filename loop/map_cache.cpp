@@ -97,6 +97,12 @@ std::string make_build_dir(const std::string& final_dir) {
   std::string name = final_dir + kBuildTempInfix + "XXXXXX";
   if (::mkdtemp(name.data()) == nullptr)
     throw InputError(name + ": cannot create a temporary map folder: " + std::strerror(errno));
+  // mkdtemp makes it private (0700); once renamed it is the map, which others sharing the cache read.
+  std::error_code ec;
+  fs::permissions(name,
+                  fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
+                      fs::perms::others_exec,
+                  ec);
   return name;
 }
 

@@ -24,6 +24,7 @@ namespace {
 
 constexpr double kTrafficSpacing = 45.0;  // m between oncoming vehicles
 constexpr double kTrafficSpeed = 9.0;     // m/s
+constexpr double kCastMargin = 1.0;       // m cast beyond max_range: 50 times the range noise (2 cm)
 constexpr double kRestStep = 0.1;         // m: pitch and roll follow roughness of 0.5 m wavelength and more
 constexpr ActorType kTrafficTypes[] = {ActorType::car, ActorType::car, ActorType::truck, ActorType::bus};
 
@@ -281,6 +282,9 @@ IntensityMapBuilder drive(const WorldDescription& description, const World& worl
   // whatever the scenario's realism profile and weather.
   Hdl32eConfig lidar = hdl32e_config_for(Realism::ideal);
   lidar.unit_serial = o.survey_unit_serial;
+  // Returns beyond the map's range are dropped below: not casting rays beyond it (with a margin of 50
+  // times the range noise) saves traversing the far city and modelling returns that are thrown away.
+  lidar.max_range_m = std::min(lidar.max_range_m, o.max_range + kCastMargin);
   const LidarScanner scanner(lidar, materials, weather_config_for(Realism::ideal));
   const GroundHeight pavement = world.pavement();
   const SurveyDrive survey = mapping_survey(description, o);
