@@ -337,7 +337,9 @@ void IntensityMapBuilder::add(const Eigen::Vector2d& xy, double intensity) {
   // The header's geometry was checked when the builder was made; this runs once per ground point.
   const auto c = try_cell_index(header_, xy);
   if (!c) return;  // beyond any tile index an int can hold: no map covers it
-  open_tile({c->tile_x, c->tile_y})[flat_index(*c, header_.tile_cells)].add(intensity);
+  const std::pair<int, int> key{c->tile_x, c->tile_y};
+  if (key != last_.key) last_.cells = &open_tile(key), last_.key = key;
+  (*last_.cells)[flat_index(*c, header_.tile_cells)].add(intensity);
 }
 
 void IntensityMapBuilder::merge(const IntensityMapBuilder& other) {
@@ -376,6 +378,7 @@ std::vector<IntensityMoments>& IntensityMapBuilder::open_tile(const std::pair<in
 }
 
 std::vector<IntensityMoments> IntensityMapBuilder::take_tile(const std::pair<int, int>& key) {
+  last_ = LastTile();
   taken_.insert(std::lower_bound(taken_.begin(), taken_.end(), key), key);
   const auto it = tiles_.find(key);
   if (it == tiles_.end()) return {};

@@ -7,6 +7,7 @@
 // build parameters, and the list of tiles) and `tiles/<ix>_<iy>.tile` files, each a fixed-size binary
 // block of tile_cells x tile_cells cells with a checksum. Readers load tiles lazily and keep at most a
 // bounded number in memory, so memory does not grow with the map.
+#include <climits>
 #include <cstdint>
 #include <list>
 #include <map>
@@ -88,6 +89,19 @@ class IntensityMapBuilder {
   IntensityMapHeader header_;
   std::map<std::pair<int, int>, std::vector<IntensityMoments>> tiles_;  // row-major, y rows
   std::vector<std::pair<int, int>> taken_;                              // sorted
+  // The tile of the previous point: a drive's points come in runs in one tile, and finding it in tiles_
+  // is a fair share of an update. A copy (or move) of the builder starts without it: its pointer would
+  // lead into the original.
+  struct LastTile {
+    std::pair<int, int> key{INT32_MIN, INT32_MIN};
+    std::vector<IntensityMoments>* cells = nullptr;
+    LastTile() = default;
+    LastTile(const LastTile&) {}
+    LastTile& operator=(const LastTile&) {
+      key = {INT32_MIN, INT32_MIN}, cells = nullptr;
+      return *this;
+    }
+  } last_;
 
   std::vector<IntensityMoments>& open_tile(const std::pair<int, int>& key);  // made if new; never a taken one
 };

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include <tbb/parallel_invoke.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -169,10 +170,14 @@ MapLocation ensure_map(const std::string& world_name, const MappingOptions& opti
       });
   if (terminal) std::printf("\r%40s\r", "");
   writer.finish(header);
-  const SurveyDrive survey = mapping_survey(w.description, options);
-  write_curb_map(tmp + "/curbs.geojson", surveyed_curbs(w.world, survey, options));
-  write_intensity_pngs(tmp, tmp + "/mean.png", tmp + "/variance.png");
-  write_survey_error_png(tmp + "/survey_error.png", w.world, survey);
+  // The curbs and the pictures are independent files: made side by side.
+  tbb::parallel_invoke(
+      [&] {
+        const SurveyDrive survey = mapping_survey(w.description, options);
+        write_curb_map(tmp + "/curbs.geojson", surveyed_curbs(w.world, survey, options));
+        write_survey_error_png(tmp + "/survey_error.png", w.world, survey);
+      },
+      [&] { write_intensity_pngs(tmp, tmp + "/mean.png", tmp + "/variance.png"); });
   move_into_place(tmp, loc.dir);
   loc.built = true;
   loc.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -230,10 +230,20 @@ IntensityMapBuilder drive_part(const DriveSetup& d, const IntensityMapHeader& he
   for (size_t k = 0; k < rest.size(); ++k)
     rest[k] = rest_on_ground(path.pose_at(double(k0 + k) * kRestStep), d.pavement, survey_car.wheelbase(),
                              survey_car.track_width);
-  const PoseAt vehicle = [&](int64_t t) {
+  auto resting = [&](int64_t t) {
     const double s = o.speed * ns_to_s(t);
     const size_t k = rest_index(s);
     return to_isometry(path.pose_at(s)) * to_isometry(path.pose_at(double(k) * kRestStep)).inverse() * rest.at(k - k0);
+  };
+  // The scanner asks for the car's pose at the start of every firing cycle, and the survey places the
+  // cycle's points with the same pose: computed once per scan, on that grid.
+  const int64_t cycle_ns = d.lidar.cycle_period_ns();
+  std::vector<Eigen::Isometry3d> at_cycle(size_t(d.lidar.cycles_per_scan()) + 1);
+  int64_t grid_stamp = 0;
+  const PoseAt vehicle = [&](int64_t t) {
+    const int64_t c = (t - grid_stamp) / cycle_ns;
+    if (t >= grid_stamp && c * cycle_ns == t - grid_stamp && size_t(c) < at_cycle.size()) return at_cycle[size_t(c)];
+    return resting(t);
   };
   const PoseAt surveyed = [&](int64_t t) {
     const double s = o.speed * ns_to_s(t);
@@ -244,6 +254,8 @@ IntensityMapBuilder drive_part(const DriveSetup& d, const IntensityMapHeader& he
   };
   for (int64_t k = part.first_scan; k < part.end_scan; ++k) {
     const int64_t stamp = k * period;
+    for (size_t c = 0; c < at_cycle.size(); ++c) at_cycle[c] = resting(stamp + int64_t(c) * cycle_ns);
+    grid_stamp = stamp;
     const PointCloud cloud = d.scanner.scan(scene, vehicle, stamp, o.seed, actor_poses);
     // The survey places each point with its pose at the point's own firing cycle.
     uint32_t cycle = UINT32_MAX;
@@ -251,8 +263,8 @@ IntensityMapBuilder drive_part(const DriveSetup& d, const IntensityMapHeader& he
     for (const LidarPoint& p : cloud.points) {
       if (double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z > o.max_range * o.max_range) continue;
       if (p.intensity > 100) continue;  // a sign or a reflector, not the road surface
-      const uint32_t c = uint32_t(p.t_ns / d.lidar.cycle_period_ns());
-      if (c != cycle) cycle = c, body = surveyed(stamp + int64_t(c) * d.lidar.cycle_period_ns());
+      const uint32_t c = uint32_t(p.t_ns / cycle_ns);
+      if (c != cycle) cycle = c, body = surveyed(stamp + int64_t(c) * cycle_ns);
       // Higher than this above the ground under the car, a point cannot be ground. Level, not in the
       // plane of the wheels: on a 2 % crown that plane is 0.4 m off at 20 m across the road.
       const Eigen::Vector3d w = body * (mount * Eigen::Vector3d(p.x, p.y, p.z));
