@@ -100,13 +100,14 @@ void check_geometry(const IntensityMapHeader& h, const char* who) {
 // Index of the global cell containing `coord`, floor division (so -0.1 m is cell -1), if the tile index
 // it falls in fits an int.
 std::optional<int64_t> global_cell(double coord, double resolution, int tile_cells) {
-  double q = coord / resolution;
+  const double q = coord / resolution;
   if (!std::isfinite(q)) return std::nullopt;
-  const double nearest = std::round(q);
-  if (std::fabs(q - nearest) <=
-      kBoundarySnapUlps * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(q)))
-    q = nearest;
-  const double cell = std::floor(q);
+  // A point a few ulps past a boundary is in the cell that starts there already; one a few ulps short of
+  // it moves up into it. `next - q` is exact (Sterbenz) wherever the comparison can hold, so this is
+  // snapping q to the nearest integer first, without the call to round() (once per mapped point).
+  double cell = std::floor(q);
+  const double next = cell + 1;
+  if (next - q <= kBoundarySnapUlps * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(q))) cell = next;
   // Both bounds are exact in double (|value| < 2^44 for tile_cells <= 4096).
   const double lo = double(INT_MIN) * tile_cells;
   const double hi = (double(INT_MAX) + 1) * tile_cells - 1;
