@@ -100,13 +100,14 @@ void check_geometry(const IntensityMapHeader& h, const char* who) {
 // Index of the global cell containing `coord`, floor division (so -0.1 m is cell -1), if the tile index
 // it falls in fits an int.
 std::optional<int64_t> global_cell(double coord, double resolution, int tile_cells) {
-  double q = coord / resolution;
+  const double q = coord / resolution;
   if (!std::isfinite(q)) return std::nullopt;
-  const double nearest = std::round(q);
-  if (std::fabs(q - nearest) <=
-      kBoundarySnapUlps * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(q)))
-    q = nearest;
-  const double cell = std::floor(q);
+  // A point a few ulps past a boundary is in the cell that starts there already; one a few ulps short of
+  // it moves up into it. `next - q` is exact (Sterbenz) wherever the comparison can hold, so this is
+  // snapping q to the nearest integer first, without the call to round() (once per mapped point).
+  double cell = std::floor(q);
+  const double next = cell + 1;
+  if (next - q <= kBoundarySnapUlps * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(q))) cell = next;
   // Both bounds are exact in double (|value| < 2^44 for tile_cells <= 4096).
   const double lo = double(INT_MIN) * tile_cells;
   const double hi = (double(INT_MAX) + 1) * tile_cells - 1;
@@ -114,13 +115,14 @@ std::optional<int64_t> global_cell(double coord, double resolution, int tile_cel
   return static_cast<int64_t>(cell);
 }
 
+// Floor division: C++ '/' truncates towards zero, which would fold tiles -1 and 0 together.
+int64_t floor_div(int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
+
 std::optional<CellIndex> try_cell_index(const IntensityMapHeader& h, const Eigen::Vector2d& xy) {
   const auto gx = global_cell(xy.x(), h.resolution_m, h.tile_cells);
   const auto gy = global_cell(xy.y(), h.resolution_m, h.tile_cells);
   if (!gx || !gy) return std::nullopt;
   const int64_t n = h.tile_cells;
-  // Floor division: C++ '/' truncates towards zero, which would fold tiles -1 and 0 together.
-  auto floor_div = [](int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); };
   const int64_t tx = floor_div(*gx, n), ty = floor_div(*gy, n);
   return CellIndex{static_cast<int>(tx), static_cast<int>(ty), static_cast<int>(*gx - tx * n),
                    static_cast<int>(*gy - ty * n)};
@@ -336,18 +338,54 @@ void IntensityMapBuilder::add(const Eigen::Vector2d& xy, double intensity) {
   // The header's geometry was checked when the builder was made; this runs once per ground point.
   const auto c = try_cell_index(header_, xy);
   if (!c) return;  // beyond any tile index an int can hold: no map covers it
-  tile_or_new(tiles_, header_, {c->tile_x, c->tile_y})[flat_index(*c, header_.tile_cells)].add(intensity);
+  const std::pair<int, int> key{c->tile_x, c->tile_y};
+  if (key != last_.key) last_.cells = &open_tile(key), last_.key = key;
+  (*last_.cells)[flat_index(*c, header_.tile_cells)].add(intensity);
 }
 
 void IntensityMapBuilder::merge(const IntensityMapBuilder& other) {
   const IntensityMapHeader& o = other.header_;
-  if (o.resolution_m != header_.resolution_m || o.tile_cells != header_.tile_cells ||
-      o.origin.lat_deg != header_.origin.lat_deg || o.origin.lon_deg != header_.origin.lon_deg)
-    throw std::invalid_argument("IntensityMapBuilder::merge: maps differ in origin, resolution or tile size");
+  if (o.resolution_m != header_.resolution_m || o.origin.lat_deg != header_.origin.lat_deg ||
+      o.origin.lon_deg != header_.origin.lon_deg)
+    throw std::invalid_argument("IntensityMapBuilder::merge: maps differ in origin or resolution");
+  const int64_t n = o.tile_cells, big = header_.tile_cells;
   for (const auto& [key, cells] : other.tiles_) {
-    std::vector<IntensityMoments>& mine = tile_or_new(tiles_, header_, key);
-    for (size_t i = 0; i < mine.size(); ++i) mine[i].merge(cells[i]);
+    if (n == big) {
+      std::vector<IntensityMoments>& mine = open_tile(key);
+      for (size_t i = 0; i < mine.size(); ++i) mine[i].merge(cells[i]);
+      continue;
+    }
+    // Tiles of another size: each cell goes to the same global cell in one of this builder's tiles.
+    std::pair<int, int> last_key{INT32_MIN, INT32_MIN};
+    std::vector<IntensityMoments>* mine = nullptr;
+    for (int64_t cy = 0; cy < n; ++cy)
+      for (int64_t cx = 0; cx < n; ++cx) {
+        const IntensityMoments& m = cells[size_t(cy * n + cx)];
+        if (m.count == 0) continue;
+        const int64_t gx = int64_t(key.first) * n + cx, gy = int64_t(key.second) * n + cy;
+        const int64_t tx = floor_div(gx, big), ty = floor_div(gy, big);
+        const std::pair<int, int> target{int(tx), int(ty)};
+        if (target != last_key) last_key = target, mine = &open_tile(target);
+        (*mine)[size_t((gy - ty * big) * big + (gx - tx * big))].merge(m);
+      }
   }
+}
+
+std::vector<IntensityMoments>& IntensityMapBuilder::open_tile(const std::pair<int, int>& key) {
+  if (std::binary_search(taken_.begin(), taken_.end(), key))
+    throw std::logic_error("IntensityMapBuilder: a point falls in tile " + tile_name(key.first, key.second) +
+                           ", which was already handed over as finished");
+  return tile_or_new(tiles_, header_, key);
+}
+
+std::vector<IntensityMoments> IntensityMapBuilder::take_tile(const std::pair<int, int>& key) {
+  last_ = LastTile();
+  taken_.insert(std::lower_bound(taken_.begin(), taken_.end(), key), key);
+  const auto it = tiles_.find(key);
+  if (it == tiles_.end()) return {};
+  std::vector<IntensityMoments> cells = std::move(it->second);
+  tiles_.erase(it);
+  return cells;
 }
 
 std::optional<IntensityCell> IntensityMapBuilder::cell(const Eigen::Vector2d& xy) const {
@@ -361,6 +399,14 @@ std::optional<IntensityCell> IntensityMapBuilder::cell(const Eigen::Vector2d& xy
 }
 
 void IntensityMapBuilder::save(const std::string& dir) const {
+  if (!taken_.empty())
+    throw std::logic_error("IntensityMapBuilder::save: tiles were handed over; write them as they come");
+  IntensityMapWriter writer(dir);
+  for (const auto& [key, cells] : tiles_) writer.write_tile(header_, key, cells);
+  writer.finish(header_);
+}
+
+IntensityMapWriter::IntensityMapWriter(const std::string& dir) : dir_(dir) {
   const fs::path root(dir), tiles_dir = root / kTilesDir;
   std::error_code ec;
   fs::create_directories(tiles_dir, ec);
@@ -379,10 +425,24 @@ void IntensityMapBuilder::save(const std::string& dir) const {
   if (ec) throw InputError(tiles_dir.string() + ": cannot list directory: " + ec.message());
   for (const fs::path& path : stale)
     if (fs::remove(path, ec); ec) throw InputError(path.string() + ": cannot remove stale tile: " + ec.message());
-  for (const auto& [key, cells] : tiles_)
-    write_file_atomically(tiles_dir / tile_file_name(key.first, key.second),
-                          encode_tile(key.first, key.second, header_.tile_cells, cells));
-  write_file_atomically(root / kHeaderFile, header_yaml(header_));  // last: the map exists once it is whole
+}
+
+void IntensityMapWriter::write_tile(const IntensityMapHeader& header, const std::pair<int, int>& key,
+                                    const std::vector<IntensityMoments>& cells) {
+  if (cells.size() != size_t(header.tile_cells) * size_t(header.tile_cells))
+    throw std::invalid_argument("IntensityMapWriter: tile " + tile_name(key.first, key.second) + " has " +
+                                std::to_string(cells.size()) + " cells, not tile_cells^2");
+  write_file_atomically(fs::path(dir_) / kTilesDir / tile_file_name(key.first, key.second),
+                        encode_tile(key.first, key.second, header.tile_cells, cells));
+  written_.insert(std::lower_bound(written_.begin(), written_.end(), key), key);
+}
+
+void IntensityMapWriter::finish(const IntensityMapHeader& header) {
+  std::vector<std::pair<int, int>> listed = header.tiles;
+  std::sort(listed.begin(), listed.end());
+  if (listed != written_)
+    throw std::logic_error("IntensityMapWriter::finish: the header lists other tiles than were written");
+  write_file_atomically(fs::path(dir_) / kHeaderFile, header_yaml(header));  // last: the map exists once it is whole
 }
 
 IntensityMapHeader read_intensity_map_header(const std::string& dir) {

@@ -7,6 +7,7 @@
 // build parameters, and the list of tiles) and `tiles/<ix>_<iy>.tile` files, each a fixed-size binary
 // block of tile_cells x tile_cells cells with a checksum. Readers load tiles lazily and keep at most a
 // bounded number in memory, so memory does not grow with the map.
+#include <climits>
 #include <cstdint>
 #include <list>
 #include <map>
@@ -70,16 +71,56 @@ class IntensityMapBuilder {
  public:
   explicit IntensityMapBuilder(IntensityMapHeader header);
   void add(const Eigen::Vector2d& xy, double intensity);
-  void merge(const IntensityMapBuilder& other);  // same header geometry required
+  // Chan's merge of every cell of `other`, which must have the same origin and resolution; its tiles may
+  // be of another size (a small builder that holds only the blocks a part of a drive touched).
+  void merge(const IntensityMapBuilder& other);
   std::optional<IntensityCell> cell(const Eigen::Vector2d& xy) const;
+  // The header; its tile list is every tile made so far, handed over or not.
   const IntensityMapHeader& header() const { return header_; }
-  size_t tile_count() const { return tiles_.size(); }
+  size_t tile_count() const { return tiles_.size(); }  // held in memory
+  // Hands over a finished tile and frees it: its cells, row-major (empty if the builder has none there).
+  // A point or a merge that lands in it later is a logic error, and save() refuses a builder that handed
+  // tiles over (an IntensityMapWriter writes them as they come).
+  std::vector<IntensityMoments> take_tile(const std::pair<int, int>& key);
   // Writes map.yaml and the tiles into `dir` (created; an existing map there is replaced).
   void save(const std::string& dir) const;
 
  private:
   IntensityMapHeader header_;
   std::map<std::pair<int, int>, std::vector<IntensityMoments>> tiles_;  // row-major, y rows
+  std::vector<std::pair<int, int>> taken_;                              // sorted
+  // The tile of the previous point: a drive's points come in runs in one tile, and finding it in tiles_
+  // is a fair share of an update. A copy (or move) of the builder starts without it: its pointer would
+  // lead into the original.
+  struct LastTile {
+    std::pair<int, int> key{INT32_MIN, INT32_MIN};
+    std::vector<IntensityMoments>* cells = nullptr;
+    LastTile() = default;
+    LastTile(const LastTile&) {}
+    LastTile& operator=(const LastTile&) {
+      key = {INT32_MIN, INT32_MIN}, cells = nullptr;
+      return *this;
+    }
+  } last_;
+
+  std::vector<IntensityMoments>& open_tile(const std::pair<int, int>& key);  // made if new; never a taken one
+};
+
+// Writes a map tile by tile, so that a builder can hand over the tiles it has finished and forget them:
+// memory holds the tiles still open, not the map. Each tile file is written whole under a temporary
+// name and renamed; map.yaml comes last, so the folder is a map only once finish() ran.
+class IntensityMapWriter {
+ public:
+  // Creates `dir`; removes a map already there (its header first, then its tiles).
+  explicit IntensityMapWriter(const std::string& dir);
+  void write_tile(const IntensityMapHeader& header, const std::pair<int, int>& key,
+                  const std::vector<IntensityMoments>& cells);
+  // Writes map.yaml: `header` whose tile list must be exactly the tiles written.
+  void finish(const IntensityMapHeader& header);
+
+ private:
+  std::string dir_;
+  std::vector<std::pair<int, int>> written_;
 };
 
 // Reads a saved map lazily; throws InputError naming the file for a missing or corrupt header or

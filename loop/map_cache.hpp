@@ -23,6 +23,12 @@ std::string map_hash(const std::string& world, const MappingOptions& options);
 
 // Finds the map of `world` (name or world.yaml path) made with `options`, or builds it (or rebuilds
 // it with `force`). Shows progress on a terminal.
+//
+// Safe when many processes share the cache (one machine, or a shared volume: see loop/file_lock.hpp
+// for what NFS needs): a build holds the lock file <root>/<world>-<hash>.lock, looks in the cache again
+// once it has the lock (a process that waited finds the map the first one built and does not rebuild),
+// builds into a folder of its own next to the final place and renames it into place, so no one ever
+// reads half a map. Temporary folders that a crashed build left are removed by the next build.
 MapLocation ensure_map(const std::string& world, const MappingOptions& options, bool force);
 
 // A bird's-eye PNG of the intensity layer's mean (grey) and variance (colour), downsampled so the

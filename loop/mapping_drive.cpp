@@ -2,7 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <sstream>
+
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include "common/units.hpp"
 #include "sim/actor_assets.hpp"
@@ -19,6 +24,7 @@ namespace {
 
 constexpr double kTrafficSpacing = 45.0;  // m between oncoming vehicles
 constexpr double kTrafficSpeed = 9.0;     // m/s
+constexpr double kCastMargin = 1.0;       // m cast beyond max_range: 50 times the range noise (2 cm)
 constexpr double kRestStep = 0.1;         // m: pitch and roll follow roughness of 0.5 m wavelength and more
 constexpr ActorType kTrafficTypes[] = {ActorType::car, ActorType::car, ActorType::truck, ActorType::bus};
 
@@ -88,10 +94,192 @@ CurbMap surveyed_curbs(const World& world, const SurveyDrive& survey, const Mapp
   return survey_curb_map(densify_curb_map(world.curb_map(), o.survey_error.sample_spacing_m), survey);
 }
 
-IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const World& world,
-                                      const MaterialTable& materials, const std::string& actors_dir,
-                                      const MappingOptions& o, const std::string& world_hash,
-                                      const std::function<void(double)>& progress) {
+namespace {
+
+// Work items: a lane is driven in parts of kPartScans scans (24 m at 15 m/s), cast in parallel, each
+// into a small builder of its own whose blocks of kPartTileCells cells are made only where its points
+// fall. The parts are merged into the map in a fixed order, so the map's bytes are the same at any
+// thread count; a tile is handed over (written) once the last part that can reach it is merged.
+constexpr int64_t kPartScans = 16;
+constexpr int kPartTileCells = 32;
+// m added to how far a part's points can lie from its path: the path is sampled every kReachStep, and
+// the body's pitch and roll move the sensor by centimetres.
+constexpr double kReachStep = 1.0, kReachSlack = 2.0;
+// Parts in flight per worker thread: enough to keep every core busy while one waits to be merged.
+constexpr int kPartsInFlightPerThread = 2;
+
+struct DrivePart {
+  size_t lane;
+  int64_t first_scan, end_scan;
+  std::vector<std::pair<int, int>> tiles;  // of the map, that its points can reach
+  std::pair<int, int> where;               // the tile of its middle: parts are merged in tile order
+};
+
+// Everything the parts of a drive share (read only while they run).
+struct DriveSetup {
+  const World& world;
+  const MaterialTable& materials;
+  const std::string& actors_dir;
+  const MappingOptions& o;
+  const SurveyDrive& survey;
+  const Hdl32eConfig& lidar;
+  const LidarScanner& scanner;
+  // The world alone, shared by the parts: scan() changes a scene only to move its actors, and this one
+  // has none. Lanes with traffic make their own.
+  RayScene& scene;
+  const GroundHeight& pavement;
+};
+
+std::vector<ActorPlan> oncoming_traffic(const SurveyLane& lane, const MappingOptions& o) {
+  std::vector<ActorPlan> traffic;
+  if (!o.traffic || lane.road->one_way) return traffic;
+  const Path other = lane_path(*lane.road, Lane::right, !lane.backward);
+  for (double s = kTrafficSpacing / 2; s < other.length; s += kTrafficSpacing) {
+    ActorPlan a;
+    a.type = kTrafficTypes[traffic.size() % std::size(kTrafficTypes)];
+    a.path = other;
+    a.start_s = s;
+    a.speed = kTrafficSpeed;
+    traffic.push_back(a);
+  }
+  return traffic;
+}
+
+int64_t lane_scans(const SurveyLane& lane, const MappingOptions& o, const Hdl32eConfig& lidar) {
+  return int64_t(lane.path.length / o.speed / (double(lidar.scan_period_ns()) * 1e-9));
+}
+
+// The parts of every lane, in the order they are merged. A lane with traffic is one part: its actors
+// move in a scene of its own, as the lane's scans go by.
+std::vector<DrivePart> plan_parts(const IntensityMapHeader& header, const SurveyDrive& survey, const MappingOptions& o,
+                                  const Hdl32eConfig& lidar) {
+  // How far from the path a part's points can fall: the range limit from the sensor, the sensor's offset
+  // from the rear axle, and the survey error (which moves a point by its position error plus its
+  // heading error times its distance).
+  double error_xy = 0, error_yaw = 0;
+  for (const Pose2d& e : survey.error.samples)
+    error_xy = std::max(error_xy, std::hypot(e.x, e.y)), error_yaw = std::max(error_yaw, std::abs(e.yaw));
+  const double near = o.max_range + lidar.mount().translation().head<2>().norm();
+  const double reach = near + near * error_yaw + error_xy + kReachSlack;
+  const double period_s = double(lidar.scan_period_ns()) * 1e-9;
+  std::vector<DrivePart> parts;
+  for (size_t l = 0; l < survey.lanes.size(); ++l) {
+    const Path& path = survey.lanes[l].path;
+    const int64_t scans = lane_scans(survey.lanes[l], o, lidar);
+    const int64_t step =
+        o.traffic && !oncoming_traffic(survey.lanes[l], o).empty() ? std::max<int64_t>(scans, 1) : kPartScans;
+    for (int64_t first = 0; first < scans; first += step) {
+      DrivePart part{l, first, std::min(scans, first + step), {}, {}};
+      // The last scan's firing cycles run on for a scan period.
+      const double s0 = o.speed * double(part.first_scan) * period_s, s1 = o.speed * double(part.end_scan) * period_s;
+      Eigen::AlignedBox2d box;
+      for (double s = s0;; s = std::min(s1, s + kReachStep)) {
+        const Pose2d p = path.pose_at(s);
+        box.extend(Eigen::Vector2d(p.x, p.y));
+        if (s >= s1) break;
+      }
+      const CellIndex lo = cell_index(header, box.min() - Eigen::Vector2d::Constant(reach));
+      const CellIndex hi = cell_index(header, box.max() + Eigen::Vector2d::Constant(reach));
+      for (int tx = lo.tile_x; tx <= hi.tile_x; ++tx)
+        for (int ty = lo.tile_y; ty <= hi.tile_y; ++ty) part.tiles.push_back({tx, ty});
+      const Pose2d mid = path.pose_at((s0 + s1) / 2);
+      const CellIndex m = cell_index(header, {mid.x, mid.y});
+      part.where = {m.tile_x, m.tile_y};
+      parts.push_back(std::move(part));
+    }
+  }
+  // Column by column, row by row: the tiles open at any time are a few columns of the map, not the
+  // whole of a long lane's (a ring road's tiles would otherwise wait for the lanes that end on it).
+  std::stable_sort(parts.begin(), parts.end(),
+                   [](const DrivePart& a, const DrivePart& b) { return a.where < b.where; });
+  return parts;
+}
+
+// One part of a lane, driven into a builder of its own (small tiles, made where points fall).
+IntensityMapBuilder drive_part(const DriveSetup& d, const IntensityMapHeader& header, const DrivePart& part) {
+  IntensityMapHeader part_header = header;
+  part_header.tile_cells = kPartTileCells;
+  IntensityMapBuilder builder(part_header);
+  const SurveyLane& lane = d.survey.lanes[part.lane];
+  const Path& path = lane.path;
+  const MappingOptions& o = d.o;
+  const VehicleParams survey_car;
+  const int64_t period = d.lidar.scan_period_ns();
+  const Eigen::Isometry3d mount = d.lidar.mount();
+
+  // Oncoming traffic on the other side of this road, if asked: a scene of this lane's own.
+  const std::vector<ActorPlan> traffic = oncoming_traffic(lane, o);
+  std::unique_ptr<RayScene> own_scene;
+  if (!traffic.empty()) {
+    own_scene = std::make_unique<RayScene>(d.world.mesh);
+    add_actors(*own_scene, traffic, d.actors_dir, d.materials);
+  }
+  RayScene& scene = own_scene ? *own_scene : d.scene;
+  const ActorPoses actor_poses = actor_motion(traffic);
+
+  // The car is where the truth says, resting on the crowned, rough road; its scans are placed where
+  // the survey says: the survey's plan position and heading error moves the whole body.
+  // Resting poses every kRestStep along the lane (those of this part); between them the car moves in
+  // the plane with the last one's height, pitch and roll (finding them costs four ground lookups, and
+  // a scan has 2170 firing cycles).
+  const size_t rests = size_t(path.length / kRestStep) + 2;
+  auto rest_index = [&](double s) { return std::min(rests - 1, size_t(std::max(0.0, s / kRestStep))); };
+  const size_t k0 = rest_index(o.speed * ns_to_s(part.first_scan * period));
+  const size_t k1 = rest_index(o.speed * ns_to_s((part.end_scan + 1) * period)) + 1;
+  std::vector<Eigen::Isometry3d> rest(std::min(rests, k1 + 1) - k0);
+  for (size_t k = 0; k < rest.size(); ++k)
+    rest[k] = rest_on_ground(path.pose_at(double(k0 + k) * kRestStep), d.pavement, survey_car.wheelbase(),
+                             survey_car.track_width);
+  auto resting = [&](int64_t t) {
+    const double s = o.speed * ns_to_s(t);
+    const size_t k = rest_index(s);
+    return to_isometry(path.pose_at(s)) * to_isometry(path.pose_at(double(k) * kRestStep)).inverse() * rest.at(k - k0);
+  };
+  // The scanner asks for the car's pose at the start of every firing cycle, and the survey places the
+  // cycle's points with the same pose: computed once per scan, on that grid.
+  const int64_t cycle_ns = d.lidar.cycle_period_ns();
+  std::vector<Eigen::Isometry3d> at_cycle(size_t(d.lidar.cycles_per_scan()) + 1);
+  int64_t grid_stamp = 0;
+  const PoseAt vehicle = [&](int64_t t) {
+    const int64_t c = (t - grid_stamp) / cycle_ns;
+    if (t >= grid_stamp && c * cycle_ns == t - grid_stamp && size_t(c) < at_cycle.size()) return at_cycle[size_t(c)];
+    return resting(t);
+  };
+  const PoseAt surveyed = [&](int64_t t) {
+    const double s = o.speed * ns_to_s(t);
+    const Pose2d truth = path.pose_at(s);
+    const Eigen::Isometry3d error =
+        to_isometry(surveyed_pose(truth, d.survey.error.at(lane.start_m + s))) * to_isometry(truth).inverse();
+    return error * vehicle(t);
+  };
+  for (int64_t k = part.first_scan; k < part.end_scan; ++k) {
+    const int64_t stamp = k * period;
+    for (size_t c = 0; c < at_cycle.size(); ++c) at_cycle[c] = resting(stamp + int64_t(c) * cycle_ns);
+    grid_stamp = stamp;
+    const PointCloud cloud = d.scanner.scan(scene, vehicle, stamp, o.seed, actor_poses);
+    // The survey places each point with its pose at the point's own firing cycle.
+    uint32_t cycle = UINT32_MAX;
+    Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+    for (const LidarPoint& p : cloud.points) {
+      if (double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z > o.max_range * o.max_range) continue;
+      if (p.intensity > 100) continue;  // a sign or a reflector, not the road surface
+      const uint32_t c = uint32_t(p.t_ns / cycle_ns);
+      if (c != cycle) cycle = c, body = surveyed(stamp + int64_t(c) * cycle_ns);
+      // Higher than this above the ground under the car, a point cannot be ground. Level, not in the
+      // plane of the wheels: on a 2 % crown that plane is 0.4 m off at 20 m across the road.
+      const Eigen::Vector3d w = body * (mount * Eigen::Vector3d(p.x, p.y, p.z));
+      if (w.z() - body.translation().z() > o.max_ground_height) continue;
+      builder.add(w.head<2>(), p.intensity);
+    }
+  }
+  return builder;
+}
+
+// The drive itself: the map's tiles are handed to `finished` as they are finished, if it is given, or
+// kept in the builder returned.
+IntensityMapBuilder drive(const WorldDescription& description, const World& world, const MaterialTable& materials,
+                          const std::string& actors_dir, const MappingOptions& o, const std::string& world_hash,
+                          const FinishedTile* finished, const std::function<void(double)>& progress) {
   IntensityMapHeader header;
   header.world = description.name;
   header.world_hash = world_hash;
@@ -99,81 +287,75 @@ IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const
   header.origin = description.origin;
   header.resolution_m = o.resolution;
   header.tile_cells = o.tile_cells;
-  IntensityMapBuilder builder(header);
+  IntensityMapBuilder map(header);
 
   // The survey unit, of its own serial, calibrated in situ by the surveyors (no range biases or
   // intensity offsets left, no mixed returns or dropouts modelled), on a dry day: the map is the same
   // whatever the scenario's realism profile and weather.
   Hdl32eConfig lidar = hdl32e_config_for(Realism::ideal);
   lidar.unit_serial = o.survey_unit_serial;
+  // Returns beyond the map's range are dropped below: not casting rays beyond it (with a margin of 50
+  // times the range noise) saves traversing the far city and modelling returns that are thrown away.
+  lidar.max_range_m = std::min(lidar.max_range_m, o.max_range + kCastMargin);
   const LidarScanner scanner(lidar, materials, weather_config_for(Realism::ideal));
-  const Eigen::Isometry3d mount = lidar.mount();
   const GroundHeight pavement = world.pavement();
-  const VehicleParams survey_car;
-  const int64_t period = lidar.scan_period_ns();
   const SurveyDrive survey = mapping_survey(description, o);
+  RayScene scene(world.mesh);
+  const DriveSetup setup{world, materials, actors_dir, o, survey, lidar, scanner, scene, pavement};
+  const std::vector<DrivePart> parts = plan_parts(header, survey, o, lidar);
 
-  for (const SurveyLane& lane : survey.lanes) {
-    const Path& path = lane.path;
-    // A fresh scene per lane, with oncoming traffic on the other side of this road if asked.
-    RayScene scene(world.mesh);
-    std::vector<ActorPlan> traffic;
-    if (o.traffic && !lane.road->one_way) {
-      const Path other = lane_path(*lane.road, Lane::right, !lane.backward);
-      for (double s = kTrafficSpacing / 2; s < other.length; s += kTrafficSpacing) {
-        ActorPlan a;
-        a.type = kTrafficTypes[traffic.size() % std::size(kTrafficTypes)];
-        a.path = other;
-        a.start_s = s;
-        a.speed = kTrafficSpeed;
-        traffic.push_back(a);
-      }
-      add_actors(scene, traffic, actors_dir, materials);
-    }
-    const ActorPoses actor_poses = actor_motion(traffic);
-    // The car is where the truth says, resting on the crowned, rough road; its scans are placed where
-    // the survey says: the survey's plan position and heading error moves the whole body.
-    // Resting poses every kRestStep along the lane; between them the car moves in the plane with the
-    // last one's height, pitch and roll (finding them costs four ground lookups, and a scan has 2170
-    // firing cycles).
-    std::vector<Eigen::Isometry3d> rest(size_t(path.length / kRestStep) + 2);
-    for (size_t k = 0; k < rest.size(); ++k)
-      rest[k] =
-          rest_on_ground(path.pose_at(double(k) * kRestStep), pavement, survey_car.wheelbase(), survey_car.track_width);
-    const PoseAt vehicle = [&](int64_t t) {
-      const double s = o.speed * ns_to_s(t);
-      const size_t k = std::min(rest.size() - 1, size_t(std::max(0.0, s / kRestStep)));
-      return to_isometry(path.pose_at(s)) * to_isometry(path.pose_at(double(k) * kRestStep)).inverse() * rest[k];
-    };
-    const PoseAt surveyed = [&](int64_t t) {
-      const double s = o.speed * ns_to_s(t);
-      const Pose2d truth = path.pose_at(s);
-      const Eigen::Isometry3d error =
-          to_isometry(surveyed_pose(truth, survey.error.at(lane.start_m + s))) * to_isometry(truth).inverse();
-      return error * vehicle(t);
-    };
-    const int64_t scans = int64_t(path.length / o.speed / (double(period) * 1e-9));
-    for (int64_t k = 0; k < scans; ++k) {
-      const int64_t stamp = k * period;
-      const PointCloud cloud = scanner.scan(scene, vehicle, stamp, o.seed, actor_poses);
-      // The survey places each point with its pose at the point's own firing cycle.
-      uint32_t cycle = UINT32_MAX;
-      Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
-      for (const LidarPoint& p : cloud.points) {
-        if (double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z > o.max_range * o.max_range) continue;
-        if (p.intensity > 100) continue;  // a sign or a reflector, not the road surface
-        const uint32_t c = uint32_t(p.t_ns / lidar.cycle_period_ns());
-        if (c != cycle) cycle = c, body = surveyed(stamp + int64_t(c) * lidar.cycle_period_ns());
-        // Higher than this above the ground under the car, a point cannot be ground. Level, not in the
-        // plane of the wheels: on a 2 % crown that plane is 0.4 m off at 20 m across the road.
-        const Eigen::Vector3d w = body * (mount * Eigen::Vector3d(p.x, p.y, p.z));
-        if (w.z() - body.translation().z() > o.max_ground_height) continue;
-        builder.add(w.head<2>(), p.intensity);
-      }
-      if (progress) progress((lane.start_m + o.speed * ns_to_s(stamp)) / survey.length_m);
-    }
-  }
-  return builder;
+  // Which part is the last to reach each tile: once it is merged, the tile is finished.
+  std::map<std::pair<int, int>, size_t> last_part;
+  for (size_t i = 0; i < parts.size(); ++i)
+    for (const auto& key : parts[i].tiles) last_part[key] = i;
+  int64_t total_scans = 0, merged_scans = 0;
+  for (const DrivePart& p : parts) total_scans += p.end_scan - p.first_scan;
+  auto hand_over = [&](const std::pair<int, int>& key) {
+    if (!finished) return;
+    std::vector<IntensityMoments> cells = map.take_tile(key);
+    if (!cells.empty()) (*finished)(map.header(), key, cells);
+  };
+
+  struct Driven {
+    size_t part = 0;
+    std::shared_ptr<const IntensityMapBuilder> map;
+  };
+  size_t next = 0;
+  tbb::parallel_pipeline(
+      size_t(kPartsInFlightPerThread * tbb::this_task_arena::max_concurrency()),
+      tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& fc) {
+        if (next == parts.size()) fc.stop();
+        return next++;
+      }) & tbb::make_filter<size_t, Driven>(tbb::filter_mode::parallel, [&](size_t i) {
+        return Driven{i, std::make_shared<const IntensityMapBuilder>(drive_part(setup, header, parts[i]))};
+      }) & tbb::make_filter<Driven, void>(tbb::filter_mode::serial_in_order, [&](const Driven& d) {
+        map.merge(*d.map);
+        const DrivePart& part = parts[d.part];
+        for (const auto& key : part.tiles)
+          if (last_part.at(key) == d.part) hand_over(key);
+        merged_scans += part.end_scan - part.first_scan;
+        if (progress) progress(double(merged_scans) / double(std::max<int64_t>(total_scans, 1)));
+      }));
+  // Tiles no part was expected to reach (none, if the reach above is right) go last, in key order.
+  for (const auto& key : std::vector<std::pair<int, int>>(map.header().tiles))
+    if (!last_part.count(key)) hand_over(key);
+  return map;
+}
+
+}  // namespace
+
+IntensityMapHeader run_mapping_drive(const WorldDescription& description, const World& world,
+                                     const MaterialTable& materials, const std::string& actors_dir,
+                                     const MappingOptions& o, const std::string& world_hash,
+                                     const FinishedTile& finished, const std::function<void(double)>& progress) {
+  return drive(description, world, materials, actors_dir, o, world_hash, &finished, progress).header();
+}
+
+IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const World& world,
+                                      const MaterialTable& materials, const std::string& actors_dir,
+                                      const MappingOptions& o, const std::string& world_hash,
+                                      const std::function<void(double)>& progress) {
+  return drive(description, world, materials, actors_dir, o, world_hash, nullptr, progress);
 }
 
 }  // namespace lidarloop

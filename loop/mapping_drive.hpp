@@ -60,9 +60,25 @@ SurveyDrive mapping_survey(const WorldDescription& description, const MappingOpt
 CurbMap surveyed_curbs(const World& world, const SurveyDrive& survey, const MappingOptions& options);
 
 // `world_hash` identifies what the map is built from (see map_cache.hpp); it goes into the header.
+// The lanes are driven in parts of a few scans, cast in parallel (TBB) and merged into the map in a fixed
+// order (by place, then lane), so the map's bytes are the same at any thread count. This one keeps the
+// whole map in memory: for small worlds.
 IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const World& world,
                                       const MaterialTable& materials, const std::string& actors_dir,
                                       const MappingOptions& options, const std::string& world_hash,
                                       const std::function<void(double fraction)>& progress = {});
+
+// A tile of the map that no later part of the drive can reach, handed over to be written (the same
+// tiles and cells as the in-memory drive's, each handed over once; `cells` may be moved from).
+using FinishedTile = std::function<void(const IntensityMapHeader& header, const std::pair<int, int>& key,
+                                        std::vector<IntensityMoments>& cells)>;
+
+// The same drive, holding only the tiles still open (a few columns of tiles): each finished tile goes
+// to `finished`. Returns the map's header, listing every tile.
+IntensityMapHeader run_mapping_drive(const WorldDescription& description, const World& world,
+                                     const MaterialTable& materials, const std::string& actors_dir,
+                                     const MappingOptions& options, const std::string& world_hash,
+                                     const FinishedTile& finished,
+                                     const std::function<void(double fraction)>& progress = {});
 
 }  // namespace lidarloop

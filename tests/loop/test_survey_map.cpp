@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include "loop/mapping_drive.hpp"
 #include "test_support.hpp"
@@ -354,6 +355,34 @@ TEST(MappingDrive, SameSeedSameMapBytesOtherSeedOtherMap) {
   ASSERT_EQ(c.count("curbs.geojson"), 1u);
   EXPECT_NE(a.at("curbs.geojson"), c.at("curbs.geojson"));
   EXPECT_FALSE(a == c);
+}
+
+// The drive runs in parts on every core and merges them in a fixed order: the map's bytes must not
+// depend on the thread count, nor on whether the tiles are written as they are finished (what
+// `lidarloop map` does) or kept in memory until the end.
+TEST(MappingDrive, SameMapBytesAtOneAndTwoThreadsStreamedOrNot) {
+  MappingOptions o;
+  const CrosswalkRoad& r = crosswalk_road();
+  std::map<std::string, std::string> one, two;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = map_bytes(1, "one_thread");
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    const std::string dir = testing::TempDir() + "/survey_map_two_threads_streamed";
+    std::filesystem::remove_all(dir);
+    IntensityMapWriter writer(dir);
+    const IntensityMapHeader header =
+        run_mapping_drive(r.description, r.world, test::materials(), test::data_path("assets/actors"), o, "test",
+                          [&](const IntensityMapHeader& h, const std::pair<int, int>& key,
+                              std::vector<IntensityMoments>& cells) { writer.write_tile(h, key, cells); });
+    writer.finish(header);
+    write_curb_map(dir + "/curbs.geojson", surveyed_curbs(r.world, mapping_survey(r.description, o), o));
+    two = folder_bytes(dir);
+  }
+  ASSERT_GT(one.size(), 3u);  // header, curbs and tiles
+  EXPECT_TRUE(one == two) << "1 thread in memory and 2 threads streamed gave different maps";
 }
 
 TEST(MappingOptions, DescribeChangesWithEverySurveySetting) {
