@@ -52,8 +52,7 @@ YAML::Node yaml_node_at(YAML::Node root, const std::string& path) {
       walked += *key;
     } else {
       const size_t index = std::get<size_t>(step);
-      if (!node.IsSequence())
-        throw InputError(path + ": '" + walked + "' is not a list");
+      if (!node.IsSequence()) throw InputError(path + ": '" + walked + "' is not a list");
       if (index >= node.size())
         throw InputError(path + ": '" + walked + "' has " + std::to_string(node.size()) + " entries, no [" +
                          std::to_string(index) + "]");

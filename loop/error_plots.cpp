@@ -19,7 +19,6 @@ namespace {
 
 using namespace plot;
 
-
 // Look: the plot canvas's ink, and the curves' own colours.
 const cv::Scalar kCurve(180, 90, 30), kTruth(120, 120, 120), kEstimate(60, 60, 60), kBackground(205, 205, 205),
     kStart(40, 160, 40), kWorst(0, 0, 200);

@@ -85,7 +85,7 @@ void draw_axes(cv::Mat& image, const Panel& p, const std::string& title, int tar
 cv::Scalar series_colour(size_t k) {
   // Okabe & Ito's palette (BGR): blue, vermillion, bluish green, orange, reddish purple, sky blue,
   // yellow, black.
-  static const cv::Scalar palette[] = {{178, 114, 0},  {0, 94, 213},    {115, 158, 0},  {0, 159, 230},
+  static const cv::Scalar palette[] = {{178, 114, 0},   {0, 94, 213},   {115, 158, 0},  {0, 159, 230},
                                        {167, 121, 204}, {233, 180, 86}, {66, 228, 240}, {0, 0, 0}};
   return palette[k % std::size(palette)];
 }

@@ -18,10 +18,10 @@ enum class Align { left, centre, right };
 void text(cv::Mat& image, const std::string& s, cv::Point at, double scale = kTickFontScale, Align align = Align::left,
           const cv::Scalar& colour = kInk);
 
-double nice_floor(double value);                      // 1, 2 or 5 times a power of ten, the largest <= value
-double tick_step(double span, int target);            // a 1-2-5 step giving about `target` ticks
+double nice_floor(double value);            // 1, 2 or 5 times a power of ten, the largest <= value
+double tick_step(double span, int target);  // a 1-2-5 step giving about `target` ticks
 std::vector<double> ticks(double lo, double hi, double step);
-std::string tick_label(double value, double step);    // enough decimals to tell neighbouring ticks apart
+std::string tick_label(double value, double step);  // enough decimals to tell neighbouring ticks apart
 std::string fixed(double value, int decimals);
 
 // A plotting area and the data ranges mapped onto it.

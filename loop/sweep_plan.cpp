@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 constexpr double kDefaultTimeout_s = 600;  // a 60 s scenario runs in well under a minute on one core
 constexpr size_t kMaxRuns = 100000;        // a grid this large is a typo
 constexpr size_t kMaxRangeLevels = 1000;
-constexpr int kNumberDigits = 12;          // derived values written into scenarios
+constexpr int kNumberDigits = 12;  // derived values written into scenarios
 
 std::string format_number(double v) {
   char s[40];
@@ -34,7 +34,8 @@ std::string format_number(double v) {
 
 bool is_identifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
-  return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+  return std::all_of(s.begin(), s.end(),
+                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
 }
 
 // A scalar's number, or NaN for a word.
@@ -149,10 +150,10 @@ bool SweepAxis::numeric() const {
 }
 
 const std::vector<std::string>& sweep_metric_names() {
-  static const std::vector<std::string> names = {
-      "lateral_rmse_m",     "longitudinal_rmse_m", "heading_rmse_deg", "position_rmse_m", "max_position_error_m",
-      "max_lateral_m",      "max_longitudinal_m",  "max_heading_deg",  "latency_p50_ms",  "latency_p99_ms",
-      "max_lane_offset_m"};
+  static const std::vector<std::string> names = {"lateral_rmse_m",     "longitudinal_rmse_m",  "heading_rmse_deg",
+                                                 "position_rmse_m",    "max_position_error_m", "max_lateral_m",
+                                                 "max_longitudinal_m", "max_heading_deg",      "latency_p50_ms",
+                                                 "latency_p99_ms",     "max_lane_offset_m"};
   return names;
 }
 
@@ -267,7 +268,8 @@ SweepSpec load_sweep(const std::string& path) {
     c.required("of"), c.required("count");
     check_path(y, c["of"], out.of, base_doc);
     const auto steps = parse_yaml_path(out.of);
-    if (!std::holds_alternative<size_t>(steps.back())) y.fail(c["of"], "copies: `of` must name a list entry, like traffic[0]");
+    if (!std::holds_alternative<size_t>(steps.back()))
+      y.fail(c["of"], "copies: `of` must name a list entry, like traffic[0]");
     try {
       evaluate_expression(out.count, sample);
     } catch (const InputError& e) {
@@ -287,8 +289,8 @@ SweepSpec load_sweep(const std::string& path) {
 
   size_t runs = spec.seeds.size() * (spec.closed_loop ? spec.methods.size() : 1);
   for (const auto& a : spec.axes) runs *= a.levels.size();
-  if (runs > kMaxRuns) y.fail(y.root(), "the sweep has " + std::to_string(runs) + " runs, more than " +
-                                            std::to_string(kMaxRuns));
+  if (runs > kMaxRuns)
+    y.fail(y.root(), "the sweep has " + std::to_string(runs) + " runs, more than " + std::to_string(kMaxRuns));
   // Every run's scenario must load: a level that breaks the scenario fails here, not hours later.
   for (const SweepRun& r : expand_sweep(spec)) {
     try {
@@ -404,7 +406,8 @@ Shard parse_shard(const std::string& text) {
     const std::string index = text.substr(0, slash == std::string::npos ? 0 : slash);
     const std::string count = slash == std::string::npos ? "" : text.substr(slash + 1);
     for (const std::string* part : {&index, &count})
-      if (part->empty() || part->find_first_not_of("0123456789") != std::string::npos) throw std::invalid_argument(text);
+      if (part->empty() || part->find_first_not_of("0123456789") != std::string::npos)
+        throw std::invalid_argument(text);
     const Shard s{std::stoul(text.substr(0, slash)), std::stoul(text.substr(slash + 1))};
     if (s.count == 0 || s.index >= s.count) throw std::invalid_argument(text);
     return s;

@@ -46,7 +46,7 @@ struct SweepSet {
 };
 
 struct SweepCopies {
-  std::string of;  // a path to a list entry, e.g. traffic[0]
+  std::string of;     // a path to a list entry, e.g. traffic[0]
   std::string count;  // an expression: how many there are in all (1: just the original; 0: none)
   std::vector<std::pair<std::string, double>> shift;  // path within the entry -> added per copy
   std::string where;
@@ -69,11 +69,11 @@ struct SweepSpec {
 // (open loop: all of them, as `compare` does; closed loop: one).
 struct SweepRun {
   size_t index = 0;
-  std::string id;                   // folder name under runs/, fixed width
-  std::vector<size_t> level;        // per axis, the index of its level
+  std::string id;             // folder name under runs/, fixed width
+  std::vector<size_t> level;  // per axis, the index of its level
   uint64_t seed = 0;
   std::vector<std::string> methods;
-  std::string scenario_text;        // the complete scenario of this run
+  std::string scenario_text;  // the complete scenario of this run
 };
 
 // InputError naming file:line:col for anything wrong: unknown keys, an axis without levels, a path

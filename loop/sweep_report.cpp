@@ -75,8 +75,7 @@ std::vector<Row> rows_of(const SweepPlan& plan, const std::vector<RunResult>& re
   for (size_t i = 0; i < plan.runs.size(); ++i)
     for (const auto& m : plan.runs[i].methods) {
       const auto it = results[i].methods.find(m);
-      rows.push_back({&plan.runs[i], m, results[i].end.status,
-                      it == results[i].methods.end() ? nullptr : &it->second});
+      rows.push_back({&plan.runs[i], m, results[i].end.status, it == results[i].methods.end() ? nullptr : &it->second});
     }
   return rows;
 }
@@ -133,7 +132,7 @@ std::string markdown(const SweepPlan& plan, const std::vector<RunResult>& result
     for (const auto& r : plan.runs) s.insert(r.seed);
     seeds = s.size();
   }
-  md << plan.runs.size() << " runs (" << seeds << " seeds; methods " ;
+  md << plan.runs.size() << " runs (" << seeds << " seeds; methods ";
   for (size_t k = 0; k < plan.methods.size(); ++k) md << (k ? ", " : "") << plan.methods[k];
   md << "): " << status_counts(results) << ". A run fails when it misses a threshold of the base scenario's "
      << "`pass`, or does not finish (error, crash, timeout); runs not made yet (missing) are left out. Each "
@@ -221,8 +220,8 @@ void plots(const std::string& dir, const SweepPlan& plan, const std::vector<Row>
       failures.push_back(std::move(s));
     }
     write_series_plot(dir + "/failure_rate_vs_" + slug(axis.name) + ".png",
-                      "failure rate against " + axis.name + " (thresholds of the base scenario)", axis.name,
-                      categories, failures);
+                      "failure rate against " + axis.name + " (thresholds of the base scenario)", axis.name, categories,
+                      failures);
   }
   for (const auto& metric : plan.metrics) {
     std::vector<ScatterSeries> series;
@@ -242,11 +241,16 @@ void plots(const std::string& dir, const SweepPlan& plan, const std::vector<Row>
 
 const char* run_status_name(RunStatus s) {
   switch (s) {
-    case RunStatus::missing: return "missing";
-    case RunStatus::done: return "done";
-    case RunStatus::error: return "error";
-    case RunStatus::crashed: return "crashed";
-    case RunStatus::timeout: return "timeout";
+    case RunStatus::missing:
+      return "missing";
+    case RunStatus::done:
+      return "done";
+    case RunStatus::error:
+      return "error";
+    case RunStatus::crashed:
+      return "crashed";
+    case RunStatus::timeout:
+      return "timeout";
   }
   return "missing";
 }
@@ -269,8 +273,8 @@ std::string sweep_plan_json(const SweepPlan& plan) {
   }
   for (const auto& r : plan.runs)
     runs.push_back({{"id", r.id}, {"level", r.level}, {"seed", r.seed}, {"methods", r.methods}});
-  const json doc = {{"sweep", plan.sweep_file}, {"digest", plan.digest}, {"axes", axes},
-                    {"methods", plan.methods}, {"metrics", plan.metrics}, {"runs", runs}};
+  const json doc = {{"sweep", plan.sweep_file}, {"digest", plan.digest},   {"axes", axes},
+                    {"methods", plan.methods},  {"metrics", plan.metrics}, {"runs", runs}};
   return doc.dump(kJsonIndent) + "\n";
 }
 
@@ -288,8 +292,8 @@ SweepPlan read_sweep_plan(const std::string& path) {
       SweepAxis axis;
       axis.name = a.at("name").get<std::string>();
       for (const auto& l : a.at("levels"))
-        axis.levels.push_back({l.at("label").get<std::string>(),
-                               l.at("value").is_null() ? kNaN : l.at("value").get<double>(), {}});
+        axis.levels.push_back(
+            {l.at("label").get<std::string>(), l.at("value").is_null() ? kNaN : l.at("value").get<double>(), {}});
       plan.axes.push_back(std::move(axis));
     }
     for (const auto& r : doc.at("runs")) {

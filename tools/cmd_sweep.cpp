@@ -28,9 +28,7 @@ namespace fs = std::filesystem;
 
 constexpr int kSecondsPerMinute = 60;
 
-std::string default_out(const std::string& sweep_file) {
-  return "out/sweeps/" + fs::path(sweep_file).stem().string();
-}
+std::string default_out(const std::string& sweep_file) { return "out/sweeps/" + fs::path(sweep_file).stem().string(); }
 
 // Written whole or not at all: shards on a shared volume write the same files side by side.
 void write_atomically(const std::string& path, const std::string& text) {
@@ -53,7 +51,9 @@ Shard shard_of(const Args& args) {
   if (const auto s = args.value("shard")) return parse_shard(*s);
   const long shards = args.value("shards") ? args.integer("shards", 1, 1, 1L << 20) : -1;
   if (const long k8s = env_number("JOB_COMPLETION_INDEX"); k8s >= 0) {
-    if (shards < 0) throw InputError("$JOB_COMPLETION_INDEX is set (a Kubernetes Indexed Job): give --shards N, the Job's completions");
+    if (shards < 0)
+      throw InputError(
+          "$JOB_COMPLETION_INDEX is set (a Kubernetes Indexed Job): give --shards N, the Job's completions");
     return parse_shard(std::to_string(k8s) + "/" + std::to_string(shards));
   }
   if (const long task = env_number("SLURM_ARRAY_TASK_ID"); task >= 0) {
@@ -212,7 +212,8 @@ int run_sweep(const Args& args) {
   const std::string& first = args.positional().at(0);
   if (first == "merge") return run_merge(args);
   if (first == "render") return run_render(args);
-  if (args.positional().size() != 1) throw InputError("sweep: give one sweep file (or: sweep merge DIR..., sweep render FILE)");
+  if (args.positional().size() != 1)
+    throw InputError("sweep: give one sweep file (or: sweep merge DIR..., sweep render FILE)");
 
   const SweepSpec spec = load_sweep(first);
   const std::vector<SweepRun> runs = expand_sweep(spec);
@@ -241,6 +242,15 @@ int run_sweep(const Args& args) {
               pending.size(), jobs, threads);
   prepare(spec, pending);
   std::fflush(stdout);  // a pod's or a batch job's log shows what it is doing before the first run ends
+  if (args.flag("dry-run")) {
+    for (const SweepRun* r : pending) {
+      std::printf("run %s   ", r->id.c_str());
+      for (size_t a = 0; a < spec.axes.size(); ++a)
+        std::printf(" %s=%s", spec.axes[a].name.c_str(), spec.axes[a].levels[r->level[a]].label.c_str());
+      std::printf(" seed=%llu\n", (unsigned long long)r->seed);
+    }
+    return 0;
+  }
 
   std::vector<PoolTask> tasks;
   for (const SweepRun* r : pending) {
@@ -281,9 +291,10 @@ int run_sweep(const Args& args) {
     return 130;
   }
   if (shard.count > 1) {
-    std::printf("shard      %zu/%zu finished (%zu of its runs not done); join the shards' folders with:\n"
-                "           lidarloop sweep merge %s [OTHER_SHARD_FOLDERS...]\n",
-                shard.index, shard.count, unfinished, out.c_str());
+    std::printf(
+        "shard      %zu/%zu finished (%zu of its runs not done); join the shards' folders with:\n"
+        "           lidarloop sweep merge %s [OTHER_SHARD_FOLDERS...]\n",
+        shard.index, shard.count, unfinished, out.c_str());
     return unfinished ? 1 : 0;
   }
   const size_t missing = report({out}, out);
@@ -293,30 +304,32 @@ int run_sweep(const Args& args) {
 }  // namespace
 
 Command sweep_command() {
-  return {{"sweep",
-           "lidarloop sweep SWEEP.yaml [--jobs N] [--out DIR] [--shard I/N | --shards N]\n"
-           "       lidarloop sweep merge DIR... [--out DIR]\n"
-           "       lidarloop sweep render SWEEP.yaml --engine kubernetes|slurm [--shards N] [--jobs N] [--image IMAGE]\n"
-           "                              [--results DIR] [--lidarloop PATH] [--out DIR]",
-           "Run a stress sweep: a base scenario over a grid of variations, seeds and methods, as a pool of\n"
-           "processes, and report each metric and the failure rate against each varied parameter and\n"
-           "against the fraction of the curb traffic hid (sweep.csv, sweep.md, plots/). Runs already\n"
-           "complete in DIR are skipped (resume). With --shard I/N (or in a Kubernetes Indexed Job or a\n"
-           "Slurm array) it runs only its share; `merge` joins the shards' folders into the report;\n"
-           "`render` writes the Kubernetes Job or the Slurm script for a sweep. Exit 0 when every run\n"
-           "finished (a run missing a threshold counts as finished: it is data), 1 when one crashed, timed\n"
-           "out or is missing, 2 on bad input, 130 when interrupted.",
-           {{"jobs", "N", "runs at once (default: the number of cores); each gets cores/N threads"},
-            {"out", "DIR", "output folder (default out/sweeps/<sweep name>); merge and render: where the result goes"},
-            {"shard", "I/N", "run only shard I of N (0 <= I < N): the runs whose index is I modulo N"},
-            {"shards", "N", "the number of shards when the index comes from $JOB_COMPLETION_INDEX or $SLURM_ARRAY_TASK_ID"},
-            {"engine", "NAME", "render: kubernetes or slurm"},
-            {"image", "IMAGE", "render: the container image with lidarloop built (Kubernetes)"},
-            {"results", "DIR", "render: the shared folder the shards write to (default /data/sweeps/<name>)"},
-            {"lidarloop", "PATH", "render: the lidarloop executable on the cluster's nodes"}},
-           1,
-           1000},
-          run_sweep};
+  return {
+      {"sweep",
+       "lidarloop sweep SWEEP.yaml [--jobs N] [--out DIR] [--shard I/N | --shards N] [--dry-run]\n"
+       "       lidarloop sweep merge DIR... [--out DIR]\n"
+       "       lidarloop sweep render SWEEP.yaml --engine kubernetes|slurm [--shards N] [--jobs N] [--image IMAGE]\n"
+       "                              [--results DIR] [--lidarloop PATH] [--out DIR]",
+       "Run a stress sweep: a base scenario over a grid of variations, seeds and methods, as a pool of\n"
+       "processes, and report each metric and the failure rate against each varied parameter and\n"
+       "against the fraction of the curb traffic hid (sweep.csv, sweep.md, plots/). Runs already\n"
+       "complete in DIR are skipped (resume). With --shard I/N (or in a Kubernetes Indexed Job or a\n"
+       "Slurm array) it runs only its share; `merge` joins the shards' folders into the report;\n"
+       "`render` writes the Kubernetes Job or the Slurm script for a sweep. Exit 0 when every run\n"
+       "finished (a run missing a threshold counts as finished: it is data), 1 when one crashed, timed\n"
+       "out or is missing, 2 on bad input, 130 when interrupted.",
+       {{"jobs", "N", "runs at once (default: the number of cores); each gets cores/N threads"},
+        {"out", "DIR", "output folder (default out/sweeps/<sweep name>); merge and render: where the result goes"},
+        {"shard", "I/N", "run only shard I of N (0 <= I < N): the runs whose index is I modulo N"},
+        {"dry-run", "", "check every run's scenario and build the maps, list the runs, run none"},
+        {"shards", "N", "the number of shards when the index comes from $JOB_COMPLETION_INDEX or $SLURM_ARRAY_TASK_ID"},
+        {"engine", "NAME", "render: kubernetes or slurm"},
+        {"image", "IMAGE", "render: the container image with lidarloop built (Kubernetes)"},
+        {"results", "DIR", "render: the shared folder the shards write to (default /data/sweeps/<name>)"},
+        {"lidarloop", "PATH", "render: the lidarloop executable on the cluster's nodes"}},
+       1,
+       1000},
+      run_sweep};
 }
 
 }  // namespace lidarloop

@@ -16,10 +16,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr auto kPoll = std::chrono::milliseconds(20);       // how soon a finished child is replaced
-constexpr auto kTick = std::chrono::milliseconds(500);      // progress updates
-constexpr auto kGraceAfterTerm = std::chrono::seconds(5);   // an interrupted child's time to write its files
-constexpr int kExecFailed = 127;                            // the shell's code for "command not found"
+constexpr auto kPoll = std::chrono::milliseconds(20);      // how soon a finished child is replaced
+constexpr auto kTick = std::chrono::milliseconds(500);     // progress updates
+constexpr auto kGraceAfterTerm = std::chrono::seconds(5);  // an interrupted child's time to write its files
+constexpr int kExecFailed = 127;                           // the shell's code for "command not found"
 
 // A signal handler can only set a flag; this is the one piece of process-wide state, as the signal is.
 volatile std::sig_atomic_t g_stop_signal = 0;
@@ -69,7 +69,8 @@ bool run_process_pool(const std::vector<PoolTask>& tasks, int parallel,
                       const std::function<void(size_t, const PoolTaskEnd&)>& on_end,
                       const std::function<void(const PoolProgress&)>& on_tick) {
   g_stop_signal = 0;
-  struct sigaction action {}, old_int{}, old_term{};
+  struct sigaction action {
+  }, old_int{}, old_term{};
   action.sa_handler = on_stop_signal;
   sigemptyset(&action.sa_mask);
   ::sigaction(SIGINT, &action, &old_int);

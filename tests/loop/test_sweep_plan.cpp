@@ -140,16 +140,16 @@ TEST(SweepPlan, ClosedLoopGivesEachMethodItsOwnRun) {
 }
 
 TEST(SweepPlan, ErrorsNameTheLineAndTheProblem) {
-  auto has = [](const std::string& error, const std::string& part) {
-    return error.find(part) != std::string::npos;
-  };
+  auto has = [](const std::string& error, const std::string& part) { return error.find(part) != std::string::npos; };
   std::string e = error_of("unknown_key", "scenario: base.yaml\nseeds: 1-2\ngird: []\n");
   EXPECT_TRUE(has(e, "sweep.yaml:3:1: unknown key 'gird'")) << e;
   e = error_of("bad_index", "scenario: base.yaml\ngrid:\n  - path: traffic[5].speed\n    values: [1]\n");
   EXPECT_TRUE(has(e, "sweep.yaml:3:11:") && has(e, "'traffic' has 2 entries, no [5]")) << e;
-  e = error_of("zip_length", "scenario: base.yaml\ngrid:\n  - name: z\n    zip:\n      seed: [1, 2]\n      duration_s: [3]\n");
+  e = error_of("zip_length",
+               "scenario: base.yaml\ngrid:\n  - name: z\n    zip:\n      seed: [1, 2]\n      duration_s: [3]\n");
   EXPECT_TRUE(has(e, "sweep.yaml:6:19: zip 'duration_s' has 1 values, the first list 2")) << e;
-  e = error_of("two_kinds", "scenario: base.yaml\ngrid:\n  - {name: a, values: [1], range: {from: 0, to: 1, step: 1}}\n");
+  e = error_of("two_kinds",
+               "scenario: base.yaml\ngrid:\n  - {name: a, values: [1], range: {from: 0, to: 1, step: 1}}\n");
   EXPECT_TRUE(has(e, "give exactly one of values, levels, range or zip")) << e;
   e = error_of("metric", "scenario: base.yaml\nmetrics: [lateral_rmse]\n");
   EXPECT_TRUE(has(e, "sweep.yaml:2:11: unknown metric 'lateral_rmse'")) << e;
