@@ -7,6 +7,7 @@
 #include <fstream>
 #include <numbers>
 #include <optional>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -42,13 +43,6 @@ std::string seconds(int64_t stamp_ns) {
 
 json finite_or_null(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 json optional_or_null(const std::optional<double>& value) { return value ? json(*value) : json(nullptr); }
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string quoted = "\"";
-  for (char c : s) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
-}
 
 std::string xml_escaped(const std::string& s) {
   std::string out;
@@ -100,6 +94,22 @@ std::string markdown_cell(std::string s) {
 }
 
 }  // namespace
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string quoted = "\"";
+  for (char c : s) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+std::optional<std::string> read_text_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::stringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return std::nullopt;
+  return text.str();
+}
 
 void write_text_file(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -3,6 +3,7 @@
 // returned: metrics.json for machines, errors.csv per frame, TUM trajectories for evo, JUnit XML for
 // CI, and the comparison table of `lidarloop compare` (markdown for people, CSV for spreadsheets).
 // Every writer throws InputError naming the path when the file cannot be written.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,10 @@ namespace lidarloop {
 
 // Writes `text` to `path` as it is; InputError naming the path when it cannot.
 void write_text_file(const std::string& path, const std::string& text);
+// The whole file, or nothing when it cannot be read.
+std::optional<std::string> read_text_file(const std::string& path);
+// A CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break.
+std::string csv_field(const std::string& s);
 
 // metrics.json: every Metrics field (thresholds as an object, unset ones null; undefined values such
 // as the RMSE of zero frames are null too, since JSON has no NaN).

@@ -291,18 +291,6 @@ SweepSpec load_sweep(const std::string& path) {
   for (const auto& a : spec.axes) runs *= a.levels.size();
   if (runs > kMaxRuns)
     y.fail(y.root(), "the sweep has " + std::to_string(runs) + " runs, more than " + std::to_string(kMaxRuns));
-  // Every run's scenario must load: a level that breaks the scenario fails here, not hours later.
-  for (const SweepRun& r : expand_sweep(spec)) {
-    try {
-      parse_scenario(r.scenario_text, spec.scenario_file);
-    } catch (const InputError& e) {
-      std::string levels;
-      for (size_t a = 0; a < spec.axes.size(); ++a)
-        levels += (a ? ", " : "") + spec.axes[a].name + " = " + spec.axes[a].levels[r.level[a]].label;
-      throw InputError(path + ": run " + r.id + " (" + levels + ", seed " + std::to_string(r.seed) +
-                       ") makes a scenario that does not load: " + e.what());
-    }
-  }
   return spec;
 }
 
@@ -371,6 +359,19 @@ std::vector<SweepRun> expand_sweep(const SweepSpec& spec) {
       doc["seed"] = seed;
       YAML::Emitter out;
       out << doc;
+      const std::string text = std::string(out.c_str()) + "\n";
+      // The run's scenario must load: a level that breaks it fails here, not hours into the sweep.
+      try {
+        parse_scenario(text, spec.scenario_file);
+      } catch (const InputError& e) {
+        std::string levels;
+        for (size_t a = 0; a < spec.axes.size(); ++a)
+          levels += (a ? ", " : "") + spec.axes[a].name + " = " + spec.axes[a].levels[level[a]].label;
+        char id[32];
+        std::snprintf(id, sizeof id, "%0*zu", width, runs.size());
+        throw InputError(spec.file + ": run " + id + " (" + levels + ", seed " + std::to_string(seed) +
+                         ") makes a scenario that does not load: " + e.what());
+      }
       for (const auto& methods : method_groups) {
         SweepRun r;
         r.index = runs.size();
@@ -380,7 +381,7 @@ std::vector<SweepRun> expand_sweep(const SweepSpec& spec) {
         r.level = level;
         r.seed = seed;
         r.methods = methods;
-        r.scenario_text = std::string(out.c_str()) + "\n";
+        r.scenario_text = text;
         runs.push_back(std::move(r));
       }
     }

@@ -78,10 +78,11 @@ struct SweepRun {
 
 // InputError naming file:line:col for anything wrong: unknown keys, an axis without levels, a path
 // that is not in the scenario, an unknown parameter in an expression, a method or metric that does not
-// exist, a run whose scenario does not load.
+// exist.
 SweepSpec load_sweep(const std::string& path);
 
 // Every run in order: axes outermost first (the first axis varies slowest), then seeds, then methods.
+// InputError naming the run and its levels when a run's scenario does not load.
 std::vector<SweepRun> expand_sweep(const SweepSpec& spec);
 
 // The metric names a sweep can tabulate (fields of a run's metrics.json).

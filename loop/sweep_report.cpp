@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -27,26 +26,14 @@ constexpr int kCsvDigits = 6;
 constexpr int kHiddenBins = 10;  // the curb hidden, in tenths
 const char* const kHidden = "curb_hidden_fraction";
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+// The file's text, or "" when there is none: a run not made yet.
+std::string read_text(const std::string& path) { return read_text_file(path).value_or(""); }
 
 std::string number(double v, int digits = kCsvDigits) {
   if (!std::isfinite(v)) return "";
   char s[40];
   std::snprintf(s, sizeof s, "%.*g", digits, v);
   return s;
-}
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
 }
 
 // A file-name-safe version of an axis or metric name.
@@ -138,8 +125,9 @@ std::string markdown(const SweepPlan& plan, const std::vector<RunResult>& result
      << "`pass`, or does not finish (error, crash, timeout); runs not made yet (missing) are left out. Each "
      << "cell: mean ± standard deviation over the completed runs at that level (all seeds and every level of "
      << "the other axes).\n";
-  for (const auto& axis : plan.axes)
+  for (size_t a = 0; a < plan.axes.size(); ++a)
     for (const auto& method : plan.methods) {
+      const SweepAxis& axis = plan.axes[a];
       md << "\n## " << method << " against " << axis.name << "\n\n| " << axis.name << " | runs | failed |";
       for (const auto& m : plan.metrics) md << " " << m << " |";
       md << " curb hidden |\n|---|---|---|";
@@ -147,7 +135,6 @@ std::string markdown(const SweepPlan& plan, const std::vector<RunResult>& result
       md << "\n";
       for (size_t l = 0; l < axis.levels.size(); ++l) {
         std::vector<const Row*> at;
-        const size_t a = size_t(&axis - plan.axes.data());
         for (const auto& r : rows)
           if (r.method == method && r.run->level[a] == l) at.push_back(&r);
         const Summary first = summarise(at, plan.metrics.front());

@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 
 #include "common/input_error.hpp"
+#include "loop/result_files.hpp"
 #include "sim/world_assets.hpp"
 
 namespace lidarloop {
@@ -16,11 +15,9 @@ namespace {
 constexpr size_t kMaxJobName = 50;  // Kubernetes names are DNS labels (63), less the pods' suffixes
 
 std::string read_template(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot read the template");
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
+  const std::optional<std::string> text = read_text_file(path);
+  if (!text) throw InputError(path + ": cannot read the template");
+  return *text;
 }
 
 std::string fill(const std::string& path, std::string text, const std::map<std::string, std::string>& values) {

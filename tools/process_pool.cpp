@@ -42,9 +42,8 @@ pid_t start(const PoolTask& task) {
     ::close(log);
     throw InputError("cannot start a process: fork failed");
   }
-  if (pid == 0) {  // the child: only async-signal-safe calls until exec
-    ::setpgid(0, 0);
-    ::signal(SIGINT, SIG_DFL), ::signal(SIGTERM, SIG_DFL);
+  if (pid == 0) {     // the child: only async-signal-safe calls until exec
+    ::setpgid(0, 0);  // exec resets the parent's SIGINT/SIGTERM handlers to the default
     ::dup2(log, STDOUT_FILENO), ::dup2(log, STDERR_FILENO);
     const int null = ::open("/dev/null", O_RDONLY);
     if (null >= 0) ::dup2(null, STDIN_FILENO);

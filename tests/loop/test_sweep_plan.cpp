@@ -42,7 +42,7 @@ std::string write_sweep(const std::string& name, const std::string& sweep) {
 
 std::string error_of(const std::string& name, const std::string& sweep) {
   try {
-    load_sweep(write_sweep(name, sweep));
+    expand_sweep(load_sweep(write_sweep(name, sweep)));
   } catch (const InputError& e) {
     return e.what();
   }
