@@ -1,5 +1,6 @@
 #include "localizer/localizer_params.hpp"
 
+#include <cctype>
 #include <stdexcept>
 
 namespace lidarloop {
@@ -22,6 +23,83 @@ bool uses_curbs(LocalizerMethod m) {
 bool uses_intensity(LocalizerMethod m) { return m == LocalizerMethod::intensity || m == LocalizerMethod::proposed; }
 bool removes_obstacles(LocalizerMethod m) { return m != LocalizerMethod::icp && m != LocalizerMethod::gps; }
 
+std::vector<std::string> split_command_line(const std::string& text) {
+  std::vector<std::string> words;
+  std::string word;
+  bool in_word = false;
+  char quote = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quote) {
+      if (c == quote)
+        quote = 0;
+      else if (c == '\\' && quote == '"' && i + 1 < text.size() && (text[i + 1] == '"' || text[i + 1] == '\\'))
+        word += text[++i];
+      else
+        word += c;
+    } else if (c == '\'' || c == '"') {
+      quote = c;
+      in_word = true;
+    } else if (c == '\\') {
+      if (i + 1 == text.size()) throw std::invalid_argument("command line ends with a backslash: " + text);
+      word += text[++i];
+      in_word = true;
+    } else if (std::isspace(static_cast<unsigned char>(c))) {
+      if (in_word) words.push_back(std::move(word));
+      word.clear();
+      in_word = false;
+    } else {
+      word += c;
+      in_word = true;
+    }
+  }
+  if (quote) throw std::invalid_argument(std::string("unterminated ") + quote + " in command line: " + text);
+  if (in_word) words.push_back(std::move(word));
+  return words;
+}
+
+void set_method(LocalizerParams& params, const std::string& text) {
+  static const std::string exec = "exec:";
+  if (text.rfind(exec, 0) == 0) {
+    std::vector<std::string> command = split_command_line(text.substr(exec.size()));
+    if (command.empty()) throw std::invalid_argument("method '" + text + "': no program after exec:");
+    params.external.command = std::move(command);
+    return;
+  }
+  params.method = parse_localizer_method(text);
+  params.external.command.clear();
+}
+
+std::string method_label(const LocalizerParams& params) {
+  const auto& command = params.external.command;
+  if (command.empty()) return method_name(params.method);
+  const auto file_name = [](const std::string& path) { return path.substr(path.find_last_of('/') + 1); };
+  std::string label = "exec-" + file_name(command[0]);
+  if (command.size() > 1 && command[1].rfind('-', 0) != 0) label.append(1, '-').append(file_name(command[1]));
+  for (char& c : label)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
+  return label;
+}
+
+std::string method_label(const std::string& method_text) {
+  LocalizerParams params;
+  set_method(params, method_text);
+  return method_label(params);
+}
+
+std::string method_text(const LocalizerParams& params) {
+  if (params.external.command.empty()) return method_name(params.method);
+  std::string text = "exec:";
+  for (size_t i = 0; i < params.external.command.size(); ++i) {
+    const std::string& word = params.external.command[i];
+    const bool plain = !word.empty() && word.find_first_of(" \t\n'\"\\") == std::string::npos;
+    std::string quoted = "'";
+    for (char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    text += (i ? " " : "") + (plain ? word : quoted + "'");
+  }
+  return text;
+}
+
 void read_localizer_params(const YamlReader& y, const YAML::Node& node, LocalizerParams& p) {
   if (!node) return;
   YamlMap top(y, node, "localizer");
@@ -38,13 +116,18 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   top.number("aps_max_longitudinal_range_m", p.aps_max_longitudinal_range_m, 0.0, 50.0);
   if (const YAML::Node m = top["method"]) {
     try {
-      p.method = parse_localizer_method(y.string(m, "method"));
+      set_method(p, y.string(m, "method"));
     } catch (const std::invalid_argument& e) {
       y.fail(m, e.what());
     }
   }
   top.integer("seed", p.seed, 0, uint64_t(1) << 62);
 
+  YamlMap(y, top["external"], "external")
+      .number("deadline_ms", p.external.deadline_ms, 1.0, 60000.0)
+      .number("startup_timeout_s", p.external.startup_timeout_s, 0.1, 600.0)
+      .number("exit_timeout_s", p.external.exit_timeout_s, 0.1, 600.0)
+      .done();
   YamlMap(y, top["corridor"], "corridor")
       .integer("width_cells", p.corridor.width_cells, 10, 4000)
       .integer("height_cells", p.corridor.height_cells, 10, 4000)

@@ -55,8 +55,20 @@ struct GpsNoise {
   double variance_scale = 10.0;
 };
 
+// A localizer that is another program, in the loop instead of a built-in method (`exec:PROGRAM ARGS`;
+// loop/external_localizer.hpp runs it). The localizer itself never reads these.
+struct ExternalLocalizerParams {
+  std::vector<std::string> command;  // program and arguments; empty: a built-in method
+  // Per scan, from its first byte sent to the answer: at 10 Hz a later answer arrives after the next
+  // scan, too late for a car running in real time.
+  double deadline_ms = 100;
+  double startup_timeout_s = 10;  // for the first scan's answer instead: it starts, loads its map
+  double exit_timeout_s = 2;      // to exit after the end of the stream
+};
+
 struct LocalizerParams {
   LocalizerMethod method = LocalizerMethod::proposed;
+  ExternalLocalizerParams external;
   bool deskew = true;  // beyond the paper: per-point motion compensation from CAN
   // The LiDAR's pose in the vehicle frame (the extrinsic calibration). Not in YAML: it comes with the
   // sensor data (scenario's lidar section, a log's transforms).
@@ -104,6 +116,20 @@ struct LocalizerParams {
   GpsNoise gps_noise;
   HealthParams health;
 };
+
+// A method as scenarios and the command line give it: a built-in name, or "exec:PROGRAM ARGS" (words
+// split as a shell would, with '...' and "..." quoting and backslash escapes, no expansion). Throws
+// std::invalid_argument naming what is wrong.
+void set_method(LocalizerParams& params, const std::string& text);
+// The method's name for tables and folders: the built-in's, or "exec-" and the program's file name
+// (and its first argument's, as in `node localizer.mjs`), in [A-Za-z0-9._-].
+std::string method_label(const LocalizerParams& params);
+// The same from a method's text (as set_method takes it).
+std::string method_label(const std::string& method_text);
+// The text set_method takes back: the built-in's name, or "exec:" and the words, quoted where needed.
+std::string method_text(const LocalizerParams& params);
+// The words of a command line (see set_method).
+std::vector<std::string> split_command_line(const std::string& text);
 
 // Overrides `params` from a `localizer:` mapping (the key `method` included). Unknown keys, wrong
 // types and out-of-range values are InputErrors naming the file, line and column.

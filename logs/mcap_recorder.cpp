@@ -25,6 +25,18 @@ std::string qos_profile(bool latched) {
 
 McapRecorder::McapRecorder(const std::string& path, const Eigen::Isometry3d& lidar_mount, McapWriterOptions options)
     : writer_(path, std::move(options)) {
+  write_transforms(lidar_mount);
+}
+
+McapRecorder::McapRecorder(const std::string& name, McapOutput::ByteSink sink, const Eigen::Isometry3d& lidar_mount,
+                           McapWriterOptions options, const std::string& metadata_name,
+                           const std::map<std::string, std::string>& metadata)
+    : writer_(name, std::move(sink), std::move(options)) {
+  writer_.add_metadata(metadata_name, metadata);
+  write_transforms(lidar_mount);
+}
+
+void McapRecorder::write_transforms(const Eigen::Isometry3d& lidar_mount) {
   static constexpr ChannelSpec tf_static{t::tf_static, "tf2_msgs/msg/TFMessage", true};
   write(tf_static, 0,
         ros2::encode_tf({ros2::make_transform(0, t::vehicle_frame, t::lidar_frame, lidar_mount),

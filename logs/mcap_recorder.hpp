@@ -25,6 +25,11 @@ class McapRecorder {
  public:
   // `lidar_mount`: the LiDAR's pose in the vehicle frame, published once on /tf_static.
   McapRecorder(const std::string& path, const Eigen::Isometry3d& lidar_mount, McapWriterOptions options = {});
+  // The same messages into `sink` (a live stream to another program; see McapWriter), with a Metadata
+  // record `metadata_name` first, so the reader has it before any message.
+  McapRecorder(const std::string& name, McapOutput::ByteSink sink, const Eigen::Isometry3d& lidar_mount,
+               McapWriterOptions options, const std::string& metadata_name,
+               const std::map<std::string, std::string>& metadata);
 
   void write_truth(const TruthSample& truth);
   void write_can(const CanFrame& frame);
@@ -42,6 +47,9 @@ class McapRecorder {
   void add_attachment(const std::string& name, const std::string& media_type, std::string_view bytes);
   void add_metadata(const std::string& name, const std::map<std::string, std::string>& values);
 
+  // Hands everything written so far to the file or sink.
+  void flush() { writer_.flush(); }
+
   // Finishes the file (summary, footer). The destructor does it too, but swallows errors.
   void close();
 
@@ -54,6 +62,7 @@ class McapRecorder {
     const char* type;
     bool latched = false;  // /tf_static: transient-local durability, as ROS 2 publishes it
   };
+  void write_transforms(const Eigen::Isometry3d& lidar_mount);
   void write(const ChannelSpec& spec, int64_t stamp_ns, const std::vector<uint8_t>& data);
   uint16_t channel(const ChannelSpec& spec);
 

@@ -11,6 +11,8 @@
 #include <thread>
 #include <variant>
 
+#include "loop/localizer_backend.hpp"
+
 namespace lidarloop {
 namespace {
 
@@ -28,8 +30,8 @@ class Localizers {
  public:
   Localizers(HdMap& map, const std::vector<LocalizerParams>& methods, LoopResult& result) : result_(result) {
     for (const auto& p : methods) {
-      localizers_.push_back(std::make_unique<Localizer>(map, p));
-      result_.methods.push_back({method_name(p.method), {}, {}});
+      localizers_.push_back(std::make_unique<LocalizerBackend>(map, p));
+      result_.methods.push_back({localizers_.back()->label(), {}, {}});
     }
   }
 
@@ -61,8 +63,13 @@ class Localizers {
     return primary;
   }
 
+  // After the drive: external programs are told the stream ended and must exit cleanly.
+  void finish() {
+    for (auto& l : localizers_) l->finish();
+  }
+
  private:
-  std::vector<std::unique_ptr<Localizer>> localizers_;
+  std::vector<std::unique_ptr<LocalizerBackend>> localizers_;
   std::optional<Pose2d> latest_truth_;
   LoopResult& result_;
 };
@@ -314,6 +321,7 @@ LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<Loc
     sim.set_pose_source({});
     sink.finish();
   }
+  localizers.finish();
   result.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   return result;
 }

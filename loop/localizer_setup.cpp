@@ -53,7 +53,7 @@ LocalizerParams localizer_params_for(const Scenario& s, const std::optional<std:
   }
   if (method) {
     try {
-      p.method = parse_localizer_method(*method);
+      set_method(p, *method);
     } catch (const std::invalid_argument& e) {
       throw InputError(std::string("--method: ") + e.what());
     }

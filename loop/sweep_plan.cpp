@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "common/crc32.hpp"
+#include "localizer/localizer_params.hpp"
 #include "common/localizer_method.hpp"
 #include "common/yaml_path.hpp"
 #include "common/yaml_reader.hpp"
@@ -215,7 +216,8 @@ SweepSpec load_sweep(const std::string& path) {
   spec.methods = top["methods"] ? read_words(y, top["methods"], "methods") : std::vector{scenario.localizer_method};
   for (size_t k = 0; k < spec.methods.size(); ++k) {
     try {
-      parse_localizer_method(spec.methods[k]);
+      LocalizerParams params;
+      set_method(params, spec.methods[k]);
     } catch (const std::exception& e) {
       y.fail(top["methods"][k], e.what());
     }

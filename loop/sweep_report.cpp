@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/input_error.hpp"
+#include "localizer/localizer_params.hpp"
 #include "loop/result_files.hpp"
 #include "loop/sweep_plots.hpp"
 
@@ -337,7 +338,7 @@ RunResult read_run_result(const std::string& run_dir, const SweepRun& run, const
   result.end = read_run_end(run_dir);
   if (result.end.status != RunStatus::done) return result;
   for (const auto& method : run.methods) {
-    const std::string path = run_dir + "/" + method + "/metrics.json";
+    const std::string path = run_dir + "/" + method_label(method) + "/metrics.json";
     MethodOutcome o;
     try {
       const json doc = json::parse(read_text(path));

@@ -9,10 +9,10 @@
 #include <optional>
 
 #include "common/input_error.hpp"
-#include "localizer/localizer.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/ros2_messages.hpp"
+#include "loop/localizer_backend.hpp"
 #include "loop/localizer_setup.hpp"
 #include "loop/result_files.hpp"
 #include "loop/run_outputs.hpp"
@@ -71,7 +71,7 @@ int run_replay(const Args& args) {
   const ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
   HdMap map = open_scenario_map(scenario, world);
 
-  Localizer localizer(map, params);
+  LocalizerBackend localizer(map, params);
   std::vector<TruthSample> truth;
   std::vector<LocalizerEstimate> estimates;
   std::optional<GpsFix> pending;  // a fix waits for its heading, recorded right after it
@@ -108,11 +108,12 @@ int run_replay(const Args& args) {
     }
   }
   flush_gps();
+  localizer.finish();
   if (truth.empty()) throw InputError(log + ": no " + std::string(topics::truth_state) + " messages to score against");
 
   const std::string name = std::filesystem::path(run.scenario_name).stem().string();
   const std::string out = args.text("out", "out/" + name + "-replay");
-  const ScoredRun scored = score_and_write(out, name, scenario, resolved.ego_route, truth, method_name(params.method),
+  const ScoredRun scored = score_and_write(out, name, scenario, resolved.ego_route, truth, method_label(params),
                                            estimates, nullptr, map, curb_visibility);
   std::cout << comparison_markdown({scored.metrics});
   std::printf("\nlog        %s (%zu scans, seed %llu, recorded with %s)\n", log.c_str(), scans,
@@ -130,11 +131,11 @@ int run_replay(const Args& args) {
 
 Command replay_command() {
   return {{"replay",
-           "lidarloop replay FILE.mcap [--method NAME] [--out DIR]",
+           "lidarloop replay FILE.mcap [--method NAME|exec:PROGRAM ARGS] [--out DIR]",
            "Feed a log recorded by `run --record` or `simulate --record` to the localizer and score it\n"
            "against the recorded ground truth, with the recorded scenario's thresholds. With the recorded\n"
            "method, the estimates are the live run's, bit for bit. Exit codes as for run.",
-           {{"method", "NAME", "localizer method (default: the recorded one, else the scenario's)"},
+           {{"method", "NAME", "localizer method, or exec:PROGRAM ARGS (default: the recorded one, else the scenario's)"},
             {"out", "DIR", "output folder (default out/<scenario name>-replay)"}},
            1,
            1},

@@ -83,9 +83,9 @@ int run_run(const Args& args) {
 
   HdMap map = open_scenario_map(s.scenario, s.world);
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
-  const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_name(params.method), s.scenario.duration_s};
+  const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_label(params), s.scenario.duration_s};
   const std::unique_ptr<RecordingSink> recorder =
-      start_recording(args.value("record"), s.scenario, method_name(params.method));
+      start_recording(args.value("record"), s.scenario, method_text(params));
   std::function<void(const LocalizerEstimate&)> record_estimate;
   if (recorder)
     record_estimate = [&](const LocalizerEstimate& e) {
@@ -187,7 +187,12 @@ int run_compare(const Args& args) {
   const int threads = thread_count(args);
   const auto limit = limit_threads(threads);
   LoadedScenario s = load_with_overrides(args);
-  const std::vector<std::string> methods = parse_methods(args.text("methods", "all"));
+  // --methods' list, then every --method (an exec: command line may hold commas).
+  std::vector<std::string> methods = args.values("method");
+  if (args.value("methods") || methods.empty()) {
+    std::vector<std::string> listed = parse_methods(args.text("methods", "all"));
+    methods.insert(methods.begin(), listed.begin(), listed.end());
+  }
   std::optional<PaperTable> paper;
   if (const auto word = args.value("paper")) {
     paper = parse_paper_table(*word);
@@ -251,7 +256,7 @@ Command run_command() {
            "Run a scenario with the localizer in the loop and score it against ground truth. Writes\n"
            "metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and plots to DIR. Exit 0 when\n"
            "every threshold of the scenario's `pass` holds, 1 when one fails, 2 on bad input.",
-           {{"method", "NAME", method_name_list() + " (default: the scenario's)"},
+           {{"method", "NAME", method_name_list() + ", or exec:PROGRAM ARGS (docs/external-localizer.md); default: the scenario's"},
             {"loop", "open|closed", "closed: the controller steers on the estimate (default: the scenario's)"},
             {"out", "DIR", "output folder (default out/<scenario name>)"},
             {"seed", "N", "override the scenario's seed"},
@@ -266,11 +271,12 @@ Command run_command() {
 
 Command compare_command() {
   return {{"compare",
-           "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--expect-best NAME] [--out DIR] [--seed N]\n"
-           "                        [--seeds LIST] [--paper static|dynamic] [--realism PROFILE]",
+           "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--method exec:PROGRAM ARGS]... [--expect-best NAME]\n"
+           "                        [--out DIR] [--seed N] [--seeds LIST] [--paper static|dynamic] [--realism PROFILE]",
            "Simulate a scenario once and feed the identical streams to several localizer methods; print\n"
            "and write a table like the paper's Table III (comparison.md, comparison.csv).",
-           {{"methods", "LIST", "all, or a comma-separated list of methods (default all)"},
+           {{"methods", "LIST", "all, or a comma-separated list of methods (default all, unless --method is given)"},
+            {"method", "NAME", "one more method, repeatable: a name or exec:PROGRAM ARGS (docs/external-localizer.md)"},
             {"expect-best", "NAME", "exit 1 unless this method has the lowest lateral, longitudinal and heading RMSE"},
             {"seeds", "LIST", "run every seed of a list (1,2,3) or range (1-5); print each method's mean and spread"},
             {"paper", "TABLE", "print the paper's Table II (static) or III (dynamic) beside ours"},

@@ -106,11 +106,11 @@ PoolTask task_for(const SweepSpec& spec, const SweepRun& run, const std::string&
   t.argv = {self_executable()};
   const std::string scenario = run_dir + "/scenario.yaml";
   if (run.methods.size() == 1) {
-    t.argv.insert(t.argv.end(), {"run", scenario, "--method", run.methods[0], "--out", run_dir + "/" + run.methods[0]});
+    t.argv.insert(t.argv.end(),
+                  {"run", scenario, "--method", run.methods[0], "--out", run_dir + "/" + method_label(run.methods[0])});
   } else {
-    std::string list;
-    for (const auto& m : run.methods) list += (list.empty() ? "" : ",") + m;
-    t.argv.insert(t.argv.end(), {"compare", scenario, "--methods", list, "--out", run_dir});
+    t.argv.insert(t.argv.end(), {"compare", scenario, "--out", run_dir});
+    for (const auto& m : run.methods) t.argv.insert(t.argv.end(), {"--method", m});  // exec: lines may hold commas
   }
   t.argv.insert(t.argv.end(), {"--threads", std::to_string(threads)});
   t.log_path = run_dir + "/log.txt";

@@ -20,6 +20,9 @@ McapOutput::McapOutput(const std::string& path, bool background, bool compress, 
   if (background_) worker_ = std::thread([this] { run(); });
 }
 
+McapOutput::McapOutput(const std::string& name, ByteSink sink, bool compress, int compression_level)
+    : path_(name), background_(false), compress_(compress), compressor_(compression_level), sink_(std::move(sink)) {}
+
 McapOutput::~McapOutput() {
   {
     std::lock_guard lock(mutex_);
@@ -102,8 +105,10 @@ McapOutputTotals McapOutput::totals() const {
 }
 
 void McapOutput::emit(const uint8_t* data, size_t size, bool data_section) {
-  if (!file_) throw std::logic_error("McapOutput: write after close()");
-  if (std::fwrite(data, 1, size, file_) != size)
+  if (!open_) throw std::logic_error("McapOutput: write after close()");
+  if (sink_)
+    sink_(std::span<const uint8_t>(data, size));
+  else if (std::fwrite(data, 1, size, file_) != size)
     throw InputError(path_ + ": write failed (" + std::strerror(errno) + ")");
   if (data_section) data_crc_.update(data, size);
   position_ += size;
@@ -161,7 +166,7 @@ void McapOutput::process(Job& job) {
   index.message_index_length = position_ + out.size() - indexes_start;
   emit(out.buffer().data(), out.size(), true);
   // One flush per chunk: a killed process leaves whole chunks behind, at a cost of ~1 syscall/s.
-  if (std::fflush(file_) != 0) throw InputError(path_ + ": write failed (" + std::strerror(errno) + ")");
+  if (file_ && std::fflush(file_) != 0) throw InputError(path_ + ": write failed (" + std::strerror(errno) + ")");
   chunk_indexes_.push_back(std::move(index));
 
   std::lock_guard lock(mutex_);
@@ -173,7 +178,13 @@ void McapOutput::process(Job& job) {
 
 void McapOutput::write_tail(const std::vector<uint8_t>& bytes) { emit(bytes.data(), bytes.size(), false); }
 
+void McapOutput::flush() {
+  drain();
+  if (file_ && std::fflush(file_) != 0) throw InputError(path_ + ": write failed (" + std::strerror(errno) + ")");
+}
+
 void McapOutput::close() {
+  open_ = false;
   if (!file_) return;
   const int flush_failed = std::fflush(file_);
   const int close_failed = std::fclose(file_);

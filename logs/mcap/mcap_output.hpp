@@ -12,9 +12,11 @@
 #include <cstdio>
 #include <deque>
 #include <exception>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <utility>
@@ -38,9 +40,14 @@ struct McapOutputTotals {
 
 class McapOutput {
  public:
+  // Where bytes go instead of a file: a pipe to another program, say (see McapWriter's stream mode).
+  using ByteSink = std::function<void(std::span<const uint8_t>)>;
+
   // Opens `path` for writing (InputError if it cannot). compression_level <= 0 with compress false
   // stores chunks uncompressed.
   McapOutput(const std::string& path, bool background, bool compress, int compression_level);
+  // Hands every byte to `sink`, inline (no worker thread); `name` is for error messages.
+  McapOutput(const std::string& name, ByteSink sink, bool compress, int compression_level);
   ~McapOutput();  // finishes what is queued, then closes the file; errors are swallowed here
   McapOutput(const McapOutput&) = delete;
   McapOutput& operator=(const McapOutput&) = delete;
@@ -58,6 +65,8 @@ class McapOutput {
 
   // Waits until everything queued is on disk; rethrows the first error the worker met.
   void drain();
+  // drain(), then pushes the file's buffered bytes to the operating system.
+  void flush();
   // After drain(): the data section's end, its CRC, and what the summary needs.
   uint64_t position() const { return position_; }
   uint32_t data_crc() const { return data_crc_.value(); }
@@ -87,6 +96,8 @@ class McapOutput {
   bool background_, compress_;
   ZstdCompressor compressor_;
   std::FILE* file_ = nullptr;
+  ByteSink sink_;
+  bool open_ = true;
 
   // Owned by whoever processes jobs: the worker while it runs, the caller after drain().
   uint64_t position_ = 0;

@@ -24,7 +24,11 @@ std::vector<uint8_t> chunk_records(const mcap::Chunk& chunk, const std::string& 
   return records;
 }
 
-McapReader::McapReader(const std::string& path) : stream_(path) {
+McapReader::McapReader(const std::string& path) : stream_(path) { read_header(); }
+
+McapReader::McapReader(std::FILE* stream, const std::string& name) : stream_(stream, name) { read_header(); }
+
+void McapReader::read_header() {
   stream_.read_magic();
   stream_.next(record_);
   if (record_.opcode != uint8_t(mcap::Op::header))

@@ -33,6 +33,9 @@ class McapReader {
  public:
   // Opens the file and reads the magic and the Header record.
   explicit McapReader(const std::string& path);
+  // Reads a stream as it arrives (stdin, a pipe): next() blocks until the next message is there.
+  // `stream` is not closed; `name` is for messages.
+  McapReader(std::FILE* stream, const std::string& name);
 
   const std::string& path() const { return stream_.path(); }
   const mcap::Header& header() const { return header_; }
@@ -55,6 +58,7 @@ class McapReader {
   // The message record `in` (positioned at its content) on a known channel.
   void read_message(ByteReader& in, McapMessage& out);
   void load_chunk(const McapRecord& record);
+  void read_header();
   void finish();  // after Data End: the summary, its CRC, the footer and the trailing magic
 
   McapRecordStream stream_;

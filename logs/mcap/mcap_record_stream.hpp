@@ -3,6 +3,9 @@
 // checked against what is left of the file (and a per-record ceiling) before anything is allocated,
 // so a truncated or corrupt file gives an InputError naming the file, the byte offset and the
 // problem, never a huge allocation or a read past the end.
+//
+// It also reads a stream that cannot seek (a pipe, stdin): records then come strictly in order, a
+// length is checked only against the ceiling, and the end is wherever the stream ends.
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -22,6 +25,8 @@ struct McapRecord {
 class McapRecordStream {
  public:
   explicit McapRecordStream(const std::string& path);  // InputError if it cannot be opened
+  // Reads `stream` (not owned, not closed) from where it is, in order; `name` is for messages.
+  McapRecordStream(std::FILE* stream, const std::string& name);
   ~McapRecordStream();
   McapRecordStream(const McapRecordStream&) = delete;
   McapRecordStream& operator=(const McapRecordStream&) = delete;
@@ -34,12 +39,14 @@ class McapRecordStream {
   // The 8 bytes at the current position must be the trailing magic and the end of the file.
   void read_trailing_magic();
 
+  // A file only.
   void seek(uint64_t offset);
-  // Up to n bytes at `offset` (fewer at the end of the file); does not move the position.
+  // Up to n bytes at `offset` (fewer at the end of the file); does not move the position. On a
+  // stream, only the 9-byte prefix of the record read last.
   std::vector<uint8_t> peek(uint64_t offset, size_t n);
 
   uint64_t position() const { return position_; }
-  uint64_t file_size() const { return size_; }
+  uint64_t file_size() const { return size_; }  // a stream: unknown, the largest uint64_t
   uint64_t remaining() const { return size_ - position_; }
   const std::string& path() const { return path_; }
   // Where the reader is, for messages: "FILE: byte N".
@@ -58,7 +65,11 @@ class McapRecordStream {
 
   std::string path_;
   std::FILE* file_ = nullptr;
+  bool owned_ = true, seekable_ = true;
   uint64_t size_ = 0, position_ = 0;
+  uint64_t read_position_ = 0;  // a stream's: where the next byte comes from
+  uint64_t last_offset_ = 0;    // the record read last and its prefix (peek on a stream)
+  uint8_t last_prefix_[9] = {};
   Crc32 crc_;
 };
 

@@ -12,10 +12,20 @@
 namespace lidarloop {
 
 McapWriter::McapWriter(const std::string& path, McapWriterOptions options) : path_(path), options_(std::move(options)) {
+  output_ = std::make_unique<McapOutput>(path, options_.background, options_.compress, options_.compression_level);
+  start();
+}
+
+McapWriter::McapWriter(const std::string& name, McapOutput::ByteSink sink, McapWriterOptions options)
+    : path_(name), options_(std::move(options)) {
+  output_ = std::make_unique<McapOutput>(name, std::move(sink), options_.compress, options_.compression_level);
+  start();
+}
+
+void McapWriter::start() {
   if (options_.library.empty()) options_.library = std::string("lidarloop ") + LIDARLOOP_VERSION;
   if (options_.chunk_size == 0 || options_.chunk_duration_ns <= 0)
     throw std::invalid_argument("McapWriter: chunk size and duration must be positive");
-  output_ = std::make_unique<McapOutput>(path, options_.background, options_.compress, options_.compression_level);
   ByteWriter start;
   for (uint8_t b : mcap::kMagic) start.u8(b);
   mcap::append(start, mcap::Header{options_.profile, options_.library});
@@ -76,16 +86,21 @@ void McapWriter::write_message(uint16_t channel_id, uint32_t sequence, uint64_t 
                                std::span<const uint8_t> data) {
   check_open("write_message");
   if (channel_id == 0 || channel_id > channels_.size()) throw std::invalid_argument("McapWriter: unknown channel id");
-  const auto duration = uint64_t(options_.chunk_duration_ns);
-  if (!chunk_index_entries_.empty() &&
-      std::max(chunk_end_time_, log_time) - std::min(chunk_start_time_, log_time) >= duration)
-    flush_chunk();
-
-  const bool first = chunk_index_entries_.empty();
-  chunk_index_entries_[channel_id].emplace_back(log_time, chunk_records_.size());
-  mcap::append(chunk_records_, mcap::MessageHeader{channel_id, sequence, log_time, publish_time}, data);
-  chunk_start_time_ = first ? log_time : std::min(chunk_start_time_, log_time);
-  chunk_end_time_ = first ? log_time : std::max(chunk_end_time_, log_time);
+  if (options_.chunked) {
+    const auto duration = uint64_t(options_.chunk_duration_ns);
+    if (!chunk_index_entries_.empty() &&
+        std::max(chunk_end_time_, log_time) - std::min(chunk_start_time_, log_time) >= duration)
+      flush_chunk();
+    const bool first = chunk_index_entries_.empty();
+    chunk_index_entries_[channel_id].emplace_back(log_time, chunk_records_.size());
+    mcap::append(chunk_records_, mcap::MessageHeader{channel_id, sequence, log_time, publish_time}, data);
+    chunk_start_time_ = first ? log_time : std::min(chunk_start_time_, log_time);
+    chunk_end_time_ = first ? log_time : std::max(chunk_end_time_, log_time);
+  } else {
+    ByteWriter out;
+    mcap::append(out, mcap::MessageHeader{channel_id, sequence, log_time, publish_time}, data);
+    emit(out);
+  }
 
   next_sequence_[channel_id - 1] = sequence + 1;
   statistics_.message_start_time =
@@ -112,6 +127,12 @@ void McapWriter::flush_chunk() {
   chunk_index_entries_.clear();
   ++statistics_.chunk_count;
   output_->write(std::move(chunk));
+}
+
+void McapWriter::flush() {
+  check_open("flush");
+  flush_chunk();
+  output_->flush();
 }
 
 void McapWriter::add_attachment(const mcap::Attachment& attachment) {

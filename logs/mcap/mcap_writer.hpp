@@ -34,6 +34,9 @@ struct McapWriterOptions {
   uint64_t chunk_size = 4u << 20;             // uncompressed bytes that close a chunk
   int64_t chunk_duration_ns = 1'000'000'000;  // log time a chunk may span
   bool background = true;                     // compress and write on a worker thread (same bytes)
+  // false: every message is a record of its own in the data section, readable the moment it is
+  // written (a live stream to another program); no chunks, so no message indexes either.
+  bool chunked = true;
 };
 
 struct McapWriterStats {
@@ -48,6 +51,8 @@ class McapWriter {
  public:
   // Creates (truncates) `path` and writes the magic and Header. InputError if it cannot.
   explicit McapWriter(const std::string& path, McapWriterOptions options = {});
+  // Writes to `sink` instead of a file (inline: `background` is ignored); `name` is for messages.
+  McapWriter(const std::string& name, McapOutput::ByteSink sink, McapWriterOptions options = {});
   // Closes the file if close() was not called; errors are swallowed there, so call close().
   ~McapWriter();
   McapWriter(const McapWriter&) = delete;
@@ -66,6 +71,10 @@ class McapWriter {
   void add_attachment(const mcap::Attachment& attachment);
   void add_metadata(const std::string& name, const mcap::StringMap& metadata);
 
+  // Closes the open chunk and hands everything written so far to the file or sink: a reader at the
+  // other end of a pipe then has every message up to here.
+  void flush();
+
   // Writes the last chunk, Data End, the summary and the footer, and closes the file. Errors met by
   // the worker thread (a full disk) surface here, or at the next call after them.
   void close();
@@ -75,6 +84,7 @@ class McapWriter {
   McapWriterStats stats() const;
 
  private:
+  void start();
   void emit(ByteWriter& bytes);
   void flush_chunk();
   void check_open(const char* what) const;
