@@ -41,7 +41,7 @@ if [ "$what" = run ]; then
 fi
 
 build build -DCMAKE_BUILD_TYPE=Release -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=OFF
-expect_tests build unit cli scenario map node sweep
+expect_tests build unit cli scenario map node sweep external
 ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs"
 # The unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer: only what they run is built,
 # at -O1 with line tables only (-g1: file and line in the sanitizers' stack traces), to keep

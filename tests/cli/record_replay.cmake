@@ -1,11 +1,15 @@
 # Record a run at one thread and at two: the logs must be byte-identical. Replay the log: the estimates
 # and ground truth must be the live run's exactly, and so must every accuracy figure of metrics.json
 # (latency is wall time and is not compared), the curb occlusion included (replay reads it from the log).
-# -DLIDARLOOP=... -DSCENARIO=... -DWORKDIR=...
+# -DLIDARLOOP=... -DSCENARIO=... -DWORKDIR=... [-DMETHOD=...: the run's method, recorded in the log]
 file(REMOVE_RECURSE ${WORKDIR})
 file(MAKE_DIRECTORY ${WORKDIR})
+set(method)
+if(METHOD)
+  set(method --method ${METHOD})
+endif()
 foreach(threads 1 2)
-  execute_process(COMMAND ${LIDARLOOP} run ${SCENARIO} --duration 6 --threads ${threads}
+  execute_process(COMMAND ${LIDARLOOP} run ${SCENARIO} --duration 6 --threads ${threads} ${method}
                           --record ${WORKDIR}/run_${threads}.mcap --out ${WORKDIR}/live_${threads}
                   RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT code EQUAL 0)
