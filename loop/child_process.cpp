@@ -123,8 +123,8 @@ bool ChildProcess::pump(Clock::time_point deadline) {
   for (nfds_t i = 0; i < n; ++i) {
     if (fds[i].fd == stdin_fd_ && (fds[i].revents & (POLLOUT | POLLERR | POLLHUP))) {
       const SigpipeBlocked guard;
-      const ssize_t w =
-          ::write(stdin_fd_, outgoing_.data() + outgoing_sent_, std::min<size_t>(outgoing_.size() - outgoing_sent_, 1 << 20));
+      const ssize_t w = ::write(stdin_fd_, outgoing_.data() + outgoing_sent_,
+                                std::min<size_t>(outgoing_.size() - outgoing_sent_, 1 << 20));
       if (w > 0) outgoing_sent_ += size_t(w);
       if (w < 0 && errno != EAGAIN && errno != EINTR) stdin_broken_ = true;  // EPIPE: it stopped reading
     }
@@ -138,8 +138,7 @@ bool ChildProcess::pump(Clock::time_point deadline) {
   return true;
 }
 
-ChildProcess::LineStatus ChildProcess::read_line(Clock::time_point deadline, std::string& line,
-                                                 size_t max_line_bytes) {
+ChildProcess::LineStatus ChildProcess::read_line(Clock::time_point deadline, std::string& line, size_t max_line_bytes) {
   for (;;) {
     if (const size_t end = buffer_.find('\n'); end != std::string::npos) {
       if (end > max_line_bytes) return LineStatus::too_long;

@@ -3,12 +3,12 @@
 // each wait bounded by a deadline, so a program that hangs, stops reading or dies cannot hang us.
 // Its stderr is ours (what it prints for people reaches the terminal or the run's log). It leads its
 // own process group, so stopping it also stops whatever it started (a shell, node's helpers).
+#include <sys/types.h>
 #include <chrono>
 #include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
-#include <sys/types.h>
 #include <vector>
 
 namespace lidarloop {

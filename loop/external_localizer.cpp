@@ -115,7 +115,8 @@ LocalizerEstimate ExternalLocalizer::on_scan(const PointCloud& cloud) {
     case ChildProcess::LineStatus::timed_out: {
       char text[128];
       if (first)
-        std::snprintf(text, sizeof text, "no answer within the startup timeout (%.1f s, localizer.external.startup_timeout_s)",
+        std::snprintf(text, sizeof text,
+                      "no answer within the startup timeout (%.1f s, localizer.external.startup_timeout_s)",
                       params_.external.startup_timeout_s);
       else
         std::snprintf(text, sizeof text, "no answer within the %.0f ms deadline (localizer.external.deadline_ms)",
@@ -183,7 +184,8 @@ LocalizerEstimate ExternalLocalizer::parse_answer(const std::string& line, const
           throw InputError(where + ": \"covariance\" has a value that is not a finite number");
         e.covariance(i / 3, i % 3) = c[i].get<double>();
       }
-      if ((e.covariance.diagonal().array() < 0).any()) throw InputError(where + ": \"covariance\" has a negative variance");
+      if ((e.covariance.diagonal().array() < 0).any())
+        throw InputError(where + ": \"covariance\" has a negative variance");
     }
     return e;
   } catch (const InputError& error) {
@@ -195,9 +197,8 @@ LocalizerEstimate ExternalLocalizer::parse_answer(const std::string& line, const
 
 void ExternalLocalizer::finish() {
   recorder_.close();  // Data End and the footer
-  const auto deadline =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                         std::chrono::duration<double>(params_.external.exit_timeout_s));
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(params_.external.exit_timeout_s));
   child_.close_stdin(deadline);
   const auto exit = child_.wait_exit(deadline);
   if (!exit) {

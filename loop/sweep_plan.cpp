@@ -10,10 +10,10 @@
 #include <sstream>
 
 #include "common/crc32.hpp"
-#include "localizer/localizer_params.hpp"
 #include "common/localizer_method.hpp"
 #include "common/yaml_path.hpp"
 #include "common/yaml_reader.hpp"
+#include "localizer/localizer_params.hpp"
 #include "loop/sweep_expression.hpp"
 #include "sim/scenario.hpp"
 

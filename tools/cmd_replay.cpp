@@ -130,16 +130,17 @@ int run_replay(const Args& args) {
 }  // namespace
 
 Command replay_command() {
-  return {{"replay",
-           "lidarloop replay FILE.mcap [--method NAME|exec:PROGRAM ARGS] [--out DIR]",
-           "Feed a log recorded by `run --record` or `simulate --record` to the localizer and score it\n"
-           "against the recorded ground truth, with the recorded scenario's thresholds. With the recorded\n"
-           "method, the estimates are the live run's, bit for bit. Exit codes as for run.",
-           {{"method", "NAME", "localizer method, or exec:PROGRAM ARGS (default: the recorded one, else the scenario's)"},
-            {"out", "DIR", "output folder (default out/<scenario name>-replay)"}},
-           1,
-           1},
-          run_replay};
+  return {
+      {"replay",
+       "lidarloop replay FILE.mcap [--method NAME|exec:PROGRAM ARGS] [--out DIR]",
+       "Feed a log recorded by `run --record` or `simulate --record` to the localizer and score it\n"
+       "against the recorded ground truth, with the recorded scenario's thresholds. With the recorded\n"
+       "method, the estimates are the live run's, bit for bit. Exit codes as for run.",
+       {{"method", "NAME", "localizer method, or exec:PROGRAM ARGS (default: the recorded one, else the scenario's)"},
+        {"out", "DIR", "output folder (default out/<scenario name>-replay)"}},
+       1,
+       1},
+      run_replay};
 }
 
 }  // namespace lidarloop

@@ -256,7 +256,8 @@ Command run_command() {
            "Run a scenario with the localizer in the loop and score it against ground truth. Writes\n"
            "metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and plots to DIR. Exit 0 when\n"
            "every threshold of the scenario's `pass` holds, 1 when one fails, 2 on bad input.",
-           {{"method", "NAME", method_name_list() + ", or exec:PROGRAM ARGS (docs/external-localizer.md); default: the scenario's"},
+           {{"method", "NAME",
+             method_name_list() + ", or exec:PROGRAM ARGS (docs/external-localizer.md); default: the scenario's"},
             {"loop", "open|closed", "closed: the controller steers on the estimate (default: the scenario's)"},
             {"out", "DIR", "output folder (default out/<scenario name>)"},
             {"seed", "N", "override the scenario's seed"},
@@ -270,24 +271,25 @@ Command run_command() {
 }
 
 Command compare_command() {
-  return {{"compare",
-           "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--method exec:PROGRAM ARGS]... [--expect-best NAME]\n"
-           "                        [--out DIR] [--seed N] [--seeds LIST] [--paper static|dynamic] [--realism PROFILE]",
-           "Simulate a scenario once and feed the identical streams to several localizer methods; print\n"
-           "and write a table like the paper's Table III (comparison.md, comparison.csv).",
-           {{"methods", "LIST", "all, or a comma-separated list of methods (default all, unless --method is given)"},
-            {"method", "NAME", "one more method, repeatable: a name or exec:PROGRAM ARGS (docs/external-localizer.md)"},
-            {"expect-best", "NAME", "exit 1 unless this method has the lowest lateral, longitudinal and heading RMSE"},
-            {"seeds", "LIST", "run every seed of a list (1,2,3) or range (1-5); print each method's mean and spread"},
-            {"paper", "TABLE", "print the paper's Table II (static) or III (dynamic) beside ours"},
-            {"out", "DIR", "output folder (default out/<scenario name>-compare)"},
-            {"seed", "N", "override the scenario's seed"},
-            {"realism", "PROFILE", "ideal, typical or harsh: replaces the scenario's realism profile"},
-            {"duration", "S", "override the scenario's duration, seconds"},
-            {"threads", "N", "worker threads (default: all cores)"}},
-           1,
-           1},
-          run_compare};
+  return {
+      {"compare",
+       "lidarloop compare SCENARIO.yaml [--methods all|a,b,c] [--method exec:PROGRAM ARGS]... [--expect-best NAME]\n"
+       "                        [--out DIR] [--seed N] [--seeds LIST] [--paper static|dynamic] [--realism PROFILE]",
+       "Simulate a scenario once and feed the identical streams to several localizer methods; print\n"
+       "and write a table like the paper's Table III (comparison.md, comparison.csv).",
+       {{"methods", "LIST", "all, or a comma-separated list of methods (default all, unless --method is given)"},
+        {"method", "NAME", "one more method, repeatable: a name or exec:PROGRAM ARGS (docs/external-localizer.md)"},
+        {"expect-best", "NAME", "exit 1 unless this method has the lowest lateral, longitudinal and heading RMSE"},
+        {"seeds", "LIST", "run every seed of a list (1,2,3) or range (1-5); print each method's mean and spread"},
+        {"paper", "TABLE", "print the paper's Table II (static) or III (dynamic) beside ours"},
+        {"out", "DIR", "output folder (default out/<scenario name>-compare)"},
+        {"seed", "N", "override the scenario's seed"},
+        {"realism", "PROFILE", "ideal, typical or harsh: replaces the scenario's realism profile"},
+        {"duration", "S", "override the scenario's duration, seconds"},
+        {"threads", "N", "worker threads (default: all cores)"}},
+       1,
+       1},
+      run_compare};
 }
 
 }  // namespace lidarloop

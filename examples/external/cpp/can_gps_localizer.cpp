@@ -59,8 +59,8 @@ class CanGpsFilter {
   void on_gps(const GpsFix& fix, const LocalFrame& frame) {
     if (fix.status == GpsStatus::no_fix || !std::isfinite(fix.lat_deg) || !std::isfinite(fix.lon_deg)) return;
     const Eigen::Vector2d antenna_xy = frame.to_local(fix.lat_deg, fix.lon_deg);
-    const double sigma2 = std::max({fix.position_covariance[0], fix.position_covariance[4],
-                                    noise_.min_gps_sigma_m * noise_.min_gps_sigma_m});
+    const double sigma2 = std::max(
+        {fix.position_covariance[0], fix.position_covariance[4], noise_.min_gps_sigma_m * noise_.min_gps_sigma_m});
     if (!initialized_) {
       // The first fix: its heading (from the receiver's course) and position, with their own doubt.
       pose_.yaw = fix.heading_rad;
@@ -134,8 +134,8 @@ void answer(int scan, const CanGpsFilter& filter, int64_t stamp_ns) {
   } else {
     const Pose2d& p = filter.pose();
     const Eigen::Matrix3d& c = filter.covariance();
-    std::printf("{\"scan\": %d, \"stamp_ns\": %lld, \"x\": %.17g, \"y\": %.17g, \"yaw\": %.17g, \"covariance\": [", scan,
-                static_cast<long long>(stamp_ns), p.x, p.y, p.yaw);
+    std::printf("{\"scan\": %d, \"stamp_ns\": %lld, \"x\": %.17g, \"y\": %.17g, \"yaw\": %.17g, \"covariance\": [",
+                scan, static_cast<long long>(stamp_ns), p.x, p.y, p.yaw);
     for (int i = 0; i < 9; ++i) std::printf("%s%.17g", i ? ", " : "", c(i / 3, i % 3));
     std::printf("]}\n");
   }
