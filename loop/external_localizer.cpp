@@ -99,9 +99,9 @@ void ExternalLocalizer::on_can(const CanFrame& frame) { recorder_.write_can(fram
 void ExternalLocalizer::on_gps(const GpsFix& fix) { recorder_.write_gps(fix); }
 
 LocalizerEstimate ExternalLocalizer::on_scan(const PointCloud& cloud) {
-  const auto start = Clock::now();
   recorder_.write_scan(cloud);
-  recorder_.flush();
+  recorder_.flush();                // queued: the bytes go out while we wait for the answer
+  const auto start = Clock::now();  // the program's latency, not our serialising
   const bool first = scans_ == 0;
   const auto allowed = first ? std::chrono::duration<double>(params_.external.startup_timeout_s)
                              : std::chrono::duration<double>(params_.external.deadline_ms / 1000.0);

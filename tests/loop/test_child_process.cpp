@@ -13,9 +13,7 @@ namespace {
 using Clock = ChildProcess::Clock;
 using namespace std::chrono_literals;
 
-std::span<const uint8_t> bytes(const std::string& s) {
-  return {reinterpret_cast<const uint8_t*>(s.data()), s.size()};
-}
+std::span<const uint8_t> bytes(const std::string& s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
 
 TEST(ChildProcess, SendsBytesAndReadsLinesBack) {
   ChildProcess child({"sh", "-c", "while read line; do echo \"got $line\"; done"});
