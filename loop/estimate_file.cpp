@@ -53,7 +53,7 @@ std::string joined(const std::vector<std::string>& items) {
 
 EstimateFile read_mcap_file(const std::string& path, const std::string& wanted) {
   McapReader reader(path);
-  std::map<std::string, EstimateFile> by_topic;  // every candidate topic, or only the wanted one
+  std::map<std::string, EstimateFile> by_topic;   // every candidate topic, or only the wanted one
   std::map<std::string, std::string> candidates;  // topic -> type, of every candidate channel
   for (McapMessage m; reader.next(m);) {
     const std::string type = m.schema ? full_type(m.schema->name) : "";
@@ -108,8 +108,8 @@ bool is_mcap_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   char head[8] = {};
   in.read(head, sizeof head);
-  return in.gcount() == sizeof head && std::equal(head, head + sizeof head, mcap::kMagic.begin(),
-                                                  [](char a, uint8_t b) { return uint8_t(a) == b; });
+  return in.gcount() == sizeof head &&
+         std::equal(head, head + sizeof head, mcap::kMagic.begin(), [](char a, uint8_t b) { return uint8_t(a) == b; });
 }
 
 EstimateFile read_estimate_file(const std::string& path, const std::string& topic) {

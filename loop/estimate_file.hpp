@@ -15,9 +15,9 @@
 namespace lidarloop {
 
 struct EstimateFile {
-  std::string format;  // "TUM" or "MCAP"
-  std::string topic;   // MCAP: the topic read
-  std::string type;    // MCAP: its message type
+  std::string format;               // "TUM" or "MCAP"
+  std::string topic;                // MCAP: the topic read
+  std::string type;                 // MCAP: its message type
   std::vector<std::string> frames;  // MCAP: the header frame_ids met (for a note when it is not "map")
   std::vector<EstimateRecord> estimates;
 };

@@ -51,7 +51,8 @@ RecordedLog read_recorded_log(const std::string& log) {
       out.curb_visibility.push_back(ros2::decode_curb_visibility(message.data, context));
   }
   out.run = recorded_run(reader, log);
-  if (out.truth.empty()) throw InputError(log + ": no " + std::string(topics::truth_state) + " messages to score against");
+  if (out.truth.empty())
+    throw InputError(log + ": no " + std::string(topics::truth_state) + " messages to score against");
   return out;
 }
 

@@ -30,7 +30,8 @@ TEST(TumFile, SecondsAreExactNanoseconds) {
   EXPECT_EQ(ns, 12'500'000'000);
   ASSERT_TRUE(parse_tum_seconds("0.1234567891", ns));  // ten digits: rounded to the nanosecond
   EXPECT_EQ(ns, 123'456'789);
-  for (const char* bad : {"", "abc", "1.5x", "nan", "inf", "1e300", "--1"}) EXPECT_FALSE(parse_tum_seconds(bad, ns)) << bad;
+  for (const char* bad : {"", "abc", "1.5x", "nan", "inf", "1e300", "--1"})
+    EXPECT_FALSE(parse_tum_seconds(bad, ns)) << bad;
 }
 
 TEST(TumFile, EveryPoseReadsBackBitForBit) {

@@ -21,7 +21,7 @@ namespace lidarloop {
 namespace {
 
 constexpr int64_t kMs = 1'000'000;
-constexpr double kHeading = 0.5;  // rad: a drive north-east, so lateral is not just y
+constexpr double kHeading = 0.5;   // rad: a drive north-east, so lateral is not just y
 constexpr double kLateral = 0.30;  // m to the left of the truth
 
 std::string temp(const std::string& name) { return testing::TempDir() + "estimate_file_" + name; }
@@ -39,8 +39,8 @@ std::vector<TruthPose> truth() {
 // The truth at t, moved kLateral to its left.
 Pose2d offset_pose(int64_t t) {
   const double s = 10.0 * double(t) / 1e9;
-  return {s * std::cos(kHeading) - kLateral * std::sin(kHeading), s * std::sin(kHeading) + kLateral * std::cos(kHeading),
-          kHeading};
+  return {s * std::cos(kHeading) - kLateral * std::sin(kHeading),
+          s * std::sin(kHeading) + kLateral * std::cos(kHeading), kHeading};
 }
 
 Path route() { return make_path({{0, 0}, {200 * std::cos(kHeading), 200 * std::sin(kHeading)}}, false); }
@@ -95,7 +95,8 @@ TEST(EstimateFile, McapWithOdometryAndAFullAttitude) {
     ros2::Odometry o = odometry_at(t);
     // A localizer with an IMU reports roll and pitch too: only the yaw is scored.
     o.orientation = Eigen::AngleAxisd(kHeading, Eigen::Vector3d::UnitZ()) *
-                    Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(-0.03, Eigen::Vector3d::UnitX());
+                    Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitY()) *
+                    Eigen::AngleAxisd(-0.03, Eigen::Vector3d::UnitX());
     return ros2::encode_odometry(o);
   });
   expect_offset_scored(read_estimate_file(path, "/localization/odometry"));
@@ -130,8 +131,9 @@ TEST(EstimateFile, McapTopicsMustBeFoundAndUnambiguous) {
   write_mcap(path, "geometry_msgs/msg/PoseWithCovarianceStamped", "/localization/pose",
              [](int64_t t) { return ros2::encode_pose_with_covariance_stamped(odometry_at(t)); });
   expect_input_error([&] { read_estimate_file(path, "/odom"); },
-                     path + ": no nav_msgs/msg/Odometry or geometry_msgs/msg/PoseWithCovarianceStamped on topic "
-                            "'/odom' (topics: /localization/pose, /other)");
+                     path +
+                         ": no nav_msgs/msg/Odometry or geometry_msgs/msg/PoseWithCovarianceStamped on topic "
+                         "'/odom' (topics: /localization/pose, /other)");
   const std::string none = temp("no_pose.mcap");
   write_mcap(none, "nav_msgs/msg/Odometry", "/a", [](int64_t) { return ros2::Bytes{0, 1, 0, 0, 1}; });
   expect_input_error([&] { read_estimate_file(none); }, none + ": message 1 on /a");  // a message too short
@@ -147,8 +149,9 @@ TEST(EstimateFile, McapTopicsMustBeFoundAndUnambiguous) {
     w.close();
   }
   expect_input_error([&] { read_estimate_file(two); },
-                     two + ": several nav_msgs/msg/Odometry or geometry_msgs/msg/PoseWithCovarianceStamped topics "
-                           "(/a (nav_msgs/msg/Odometry), /b (nav_msgs/msg/Odometry)); name one with --topic");
+                     two +
+                         ": several nav_msgs/msg/Odometry or geometry_msgs/msg/PoseWithCovarianceStamped topics "
+                         "(/a (nav_msgs/msg/Odometry), /b (nav_msgs/msg/Odometry)); name one with --topic");
   EXPECT_EQ(read_estimate_file(two, "/b").estimates.size(), 1u);
 
   // Stamps that go back, and a NaN.
