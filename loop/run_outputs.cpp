@@ -25,8 +25,11 @@ void write_worst_frame(const std::string& path, const WorstFrame& w, const HdMap
   title.precision(2);
   title << std::fixed << method << ": worst frame, position error " << w.error_m << " m";
   o.title = title.str();
-  o.marks = {{"curb features (placed at the estimate)", place(w.features.curbs), {0, 0, 255}},
-             {"obstacle points (placed at the estimate)", place(w.features.obstacles), {255, 0, 255}}};
+  // `score` has no features (the localizer under test is not ours): no legend for what is not drawn.
+  if (!w.features.curbs.empty())
+    o.marks.push_back({"curb features (placed at the estimate)", place(w.features.curbs), {0, 0, 255}});
+  if (!w.features.obstacles.empty())
+    o.marks.push_back({"obstacle points (placed at the estimate)", place(w.features.obstacles), {255, 0, 255}});
   o.poses = {{"ground truth", w.truth, {255, 255, 255}}, {"estimate", w.estimate, {0, 200, 255}}};
   write_birdseye_png(path, w.cloud, w.sensor_pose, map.curbs.map().curbs, o);
 }
