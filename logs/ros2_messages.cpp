@@ -357,13 +357,28 @@ Odometry planar_odometry(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matr
   return o;
 }
 
+namespace {
+
+// geometry_msgs/PoseWithCovariance, inside Odometry and PoseWithCovarianceStamped alike.
+void pose_with_covariance(CdrWriter& w, const Odometry& o) {
+  vector3(w, o.position);
+  quaternion(w, o.orientation);
+  for (double c : o.pose_covariance) w.f64(c);
+}
+
+void pose_with_covariance(CdrReader& r, Odometry& o) {
+  o.position = vector3(r);
+  o.orientation = quaternion(r);
+  for (double& c : o.pose_covariance) c = r.f64();
+}
+
+}  // namespace
+
 Bytes encode_odometry(const Odometry& o) {
   CdrWriter w;
   header(w, o.stamp_ns, o.frame_id);
   w.string(o.child_frame_id);
-  vector3(w, o.position);
-  quaternion(w, o.orientation);
-  for (double c : o.pose_covariance) w.f64(c);
+  pose_with_covariance(w, o);
   vector3(w, o.linear);
   vector3(w, o.angular);
   for (double c : o.twist_covariance) w.f64(c);
@@ -375,9 +390,7 @@ Odometry decode_odometry(View cdr, const std::string& context) {
   Odometry o;
   o.stamp_ns = header(r, &o.frame_id);
   o.child_frame_id = r.string();
-  o.position = vector3(r);
-  o.orientation = quaternion(r);
-  for (double& c : o.pose_covariance) c = r.f64();
+  pose_with_covariance(r, o);
   o.linear = vector3(r);
   o.angular = vector3(r);
   for (double& c : o.twist_covariance) c = r.f64();
@@ -395,9 +408,7 @@ Eigen::Matrix3d planar_covariance(const std::array<double, 36>& c) {
 Bytes encode_pose_with_covariance_stamped(const Odometry& o) {
   CdrWriter w;
   header(w, o.stamp_ns, o.frame_id);
-  vector3(w, o.position);
-  quaternion(w, o.orientation);
-  for (double c : o.pose_covariance) w.f64(c);
+  pose_with_covariance(w, o);
   return std::move(w.buffer());
 }
 
@@ -405,9 +416,7 @@ Odometry decode_pose_with_covariance_stamped(View cdr, const std::string& contex
   CdrReader r(cdr, context);
   Odometry o;
   o.stamp_ns = header(r, &o.frame_id);
-  o.position = vector3(r);
-  o.orientation = quaternion(r);
-  for (double& c : o.pose_covariance) c = r.f64();
+  pose_with_covariance(r, o);
   return o;
 }
 
