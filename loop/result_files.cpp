@@ -69,15 +69,15 @@ std::string joined(const std::vector<std::string>& parts, const std::string& sep
   return out;
 }
 
+// For people: fixed decimals, "n/a" where there is no value.
+std::string cell(double value, const char* pattern) { return std::isfinite(value) ? format(pattern, value) : "n/a"; }
+
 std::string summary(const Metrics& m) {
   return std::to_string(m.frames) + " frames; lateral RMSE " + format("%.3f", m.lateral_rmse_m) +
          " m, longitudinal RMSE " + format("%.3f", m.longitudinal_rmse_m) + " m, heading RMSE " +
          format("%.3f", m.heading_rmse_deg) + " deg, max position error " + format("%.3f", m.max_position_error_m) +
-         " m, latency p50 " + format("%.2f", m.latency_p50_ms) + " ms";
+         " m, latency p50 " + cell(m.latency_p50_ms, "%.2f ms") + ", coverage " + cell(100 * m.coverage, "%.1f%%");
 }
-
-// For people: fixed decimals, "n/a" where there is no value.
-std::string cell(double value, const char* pattern) { return std::isfinite(value) ? format(pattern, value) : "n/a"; }
 
 std::string markdown_cell(std::string s) {
   std::string out;
