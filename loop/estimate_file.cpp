@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 
@@ -113,6 +114,9 @@ bool is_mcap_file(const std::string& path) {
 }
 
 EstimateFile read_estimate_file(const std::string& path, const std::string& topic) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path + ": is a folder, not a file (a rosbag2 bag? give the .mcap file inside it)");
   if (is_mcap_file(path)) return read_mcap_file(path, topic);
   if (!topic.empty()) throw InputError(path + ": --topic applies to an MCAP estimate, and this is not one (TUM)");
   return read_tum_file(path);

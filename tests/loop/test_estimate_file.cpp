@@ -167,6 +167,7 @@ TEST(EstimateFile, McapTopicsMustBeFoundAndUnambiguous) {
   });
   expect_input_error([&] { read_estimate_file(nan); }, nan + ": message 1 on /o: a pose or covariance value");
   expect_input_error([&] { read_estimate_file(temp("absent.tum")); }, "absent.tum: cannot open file");
+  expect_input_error([&] { read_estimate_file(testing::TempDir()); }, "is a folder, not a file (a rosbag2 bag?");
   std::ofstream(temp("tum_with_topic.tum")) << "0 0 0 0 0 0 0 1\n";
   expect_input_error([&] { read_estimate_file(temp("tum_with_topic.tum"), "/a"); }, "--topic applies to an MCAP");
 }
