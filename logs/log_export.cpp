@@ -17,6 +17,7 @@
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/ros2_messages.hpp"
+#include "logs/tum_file.hpp"
 
 namespace lidarloop {
 
@@ -85,15 +86,11 @@ ExportResult export_tum(const std::string& log, const std::string& file, const s
   if (chosen.empty()) chosen = poses.count(log_topics::estimate) ? log_topics::estimate : log_topics::truth_odometry;
   if (!poses.count(chosen)) nothing_on(reader, chosen, "nav_msgs/msg/Odometry messages");
 
+  // Exact: the stamp in integer nanoseconds and every number read back as the same double, so a
+  // trajectory exported here and scored (`lidarloop score`) is the log's to the last bit.
   std::ofstream out = open_out(file);
-  char line[256];
-  for (const auto& o : poses[chosen]) {
-    const ros2::Stamp s = ros2::to_stamp(o.stamp_ns);
-    std::snprintf(line, sizeof line, "%d.%09u %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", s.sec, s.nanosec,
-                  o.position.x(), o.position.y(), o.position.z(), o.orientation.x(), o.orientation.y(),
-                  o.orientation.z(), o.orientation.w());
-    out << line;
-  }
+  out << kTumHeader;
+  for (const auto& o : poses[chosen]) out << tum_line({o.stamp_ns, o.position, o.orientation}) << '\n';
   if (!out.flush()) throw InputError(file + ": write failed");
   return {chosen, poses[chosen].size()};
 }

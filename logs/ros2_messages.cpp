@@ -74,8 +74,6 @@ Eigen::Quaterniond quaternion(CdrReader& r) {
   return Eigen::Quaterniond(w, x, y, z);
 }
 
-Eigen::Quaterniond yaw_quaternion(double yaw) { return Eigen::Quaterniond(std::cos(yaw / 2), 0, 0, std::sin(yaw / 2)); }
-
 void store32(uint8_t* p, uint32_t v) {
   for (int i = 0; i < 4; ++i) p[i] = uint8_t(v >> (8 * i));
 }
@@ -359,13 +357,28 @@ Odometry planar_odometry(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matr
   return o;
 }
 
+namespace {
+
+// geometry_msgs/PoseWithCovariance, inside Odometry and PoseWithCovarianceStamped alike.
+void pose_with_covariance(CdrWriter& w, const Odometry& o) {
+  vector3(w, o.position);
+  quaternion(w, o.orientation);
+  for (double c : o.pose_covariance) w.f64(c);
+}
+
+void pose_with_covariance(CdrReader& r, Odometry& o) {
+  o.position = vector3(r);
+  o.orientation = quaternion(r);
+  for (double& c : o.pose_covariance) c = r.f64();
+}
+
+}  // namespace
+
 Bytes encode_odometry(const Odometry& o) {
   CdrWriter w;
   header(w, o.stamp_ns, o.frame_id);
   w.string(o.child_frame_id);
-  vector3(w, o.position);
-  quaternion(w, o.orientation);
-  for (double c : o.pose_covariance) w.f64(c);
+  pose_with_covariance(w, o);
   vector3(w, o.linear);
   vector3(w, o.angular);
   for (double c : o.twist_covariance) w.f64(c);
@@ -377,17 +390,42 @@ Odometry decode_odometry(View cdr, const std::string& context) {
   Odometry o;
   o.stamp_ns = header(r, &o.frame_id);
   o.child_frame_id = r.string();
-  o.position = vector3(r);
-  o.orientation = quaternion(r);
-  for (double& c : o.pose_covariance) c = r.f64();
+  pose_with_covariance(r, o);
   o.linear = vector3(r);
   o.angular = vector3(r);
   for (double& c : o.twist_covariance) c = r.f64();
   return o;
 }
 
+Eigen::Matrix3d planar_covariance(const std::array<double, 36>& c) {
+  constexpr size_t kIndex[3] = {0, 1, 5};  // as in planar_odometry
+  Eigen::Matrix3d cov;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) cov(i, j) = c[kIndex[i] * 6 + kIndex[j]];
+  return cov;
+}
+
+Bytes encode_pose_with_covariance_stamped(const Odometry& o) {
+  CdrWriter w;
+  header(w, o.stamp_ns, o.frame_id);
+  pose_with_covariance(w, o);
+  return std::move(w.buffer());
+}
+
+Odometry decode_pose_with_covariance_stamped(View cdr, const std::string& context) {
+  CdrReader r(cdr, context);
+  Odometry o;
+  o.stamp_ns = header(r, &o.frame_id);
+  pose_with_covariance(r, o);
+  return o;
+}
+
+Eigen::Quaterniond yaw_quaternion(double yaw) { return Eigen::Quaterniond(std::cos(yaw / 2), 0, 0, std::sin(yaw / 2)); }
+
 double yaw_of(const Eigen::Quaterniond& q) {
-  return std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
+  // w^2 + x^2 - y^2 - z^2 is 1 - 2 (y^2 + z^2) for a unit quaternion, and scales with the quaternion
+  // as the first argument does.
+  return std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), q.w() * q.w() + q.x() * q.x() - q.y() * q.y() - q.z() * q.z());
 }
 
 Transform make_transform(int64_t stamp_ns, const std::string& parent, const std::string& child,

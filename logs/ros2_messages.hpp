@@ -92,7 +92,23 @@ Odometry planar_odometry(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matr
                          const std::string& frame_id, const std::string& child_frame_id);
 Bytes encode_odometry(const Odometry& odom);
 Odometry decode_odometry(View cdr, const std::string& context);
+// The (x, y, yaw) block (rows and columns 0, 1, 5) of a 6x6 pose covariance: planar_odometry's inverse.
+Eigen::Matrix3d planar_covariance(const std::array<double, 36>& pose_covariance);
+
+// geometry_msgs/msg/PoseWithCovarianceStamped (what AMCL-like localizers publish), decoded as an
+// Odometry with no child frame and no twist.
+Bytes encode_pose_with_covariance_stamped(const Odometry& pose);
+Odometry decode_pose_with_covariance_stamped(View cdr, const std::string& context);
+
+// The one pair of functions every planar yaw goes through on its way into and out of a message or a
+// TUM file: a rotation by `yaw` about z, and the yaw (rotation about z of the ZYX Euler angles) of any
+// quaternion, unit or not (the formula is invariant to the quaternion's scale, so a quaternion
+// written with few digits still gives its yaw). The live run scores published_yaw(yaw), the yaw as
+// a reader of the log gets it back, so scoring the log's estimate gives the live run's numbers bit
+// for bit.
+Eigen::Quaterniond yaw_quaternion(double yaw);
 double yaw_of(const Eigen::Quaterniond& q);
+inline double published_yaw(double yaw) { return yaw_of(yaw_quaternion(yaw)); }
 
 // tf2_msgs/msg/TFMessage.
 struct Transform {

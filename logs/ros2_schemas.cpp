@@ -89,6 +89,9 @@ const std::map<std::string, std::string>& definitions() {
       {"geometry_msgs/PoseWithCovariance",
        "geometry_msgs/Pose pose\n"
        "float64[36] covariance\n"},
+      {"geometry_msgs/PoseWithCovarianceStamped",
+       "std_msgs/Header header\n"
+       "geometry_msgs/PoseWithCovariance pose\n"},
       {"geometry_msgs/Twist",
        "geometry_msgs/Vector3 linear\n"
        "geometry_msgs/Vector3 angular\n"},

@@ -13,6 +13,8 @@
 
 #include "common/input_error.hpp"
 #include "common/units.hpp"
+#include "logs/ros2_messages.hpp"
+#include "logs/tum_file.hpp"
 
 namespace lidarloop {
 
@@ -30,16 +32,6 @@ std::string format(const char* pattern, double value) {
 
 // Full precision for machines; "nan" stays as it is (pandas and numpy read it).
 std::string number(double value) { return format("%.9g", value); }
-
-// Exact seconds from integer nanoseconds: no rounding through a double.
-std::string seconds(int64_t stamp_ns) {
-  const char* sign = stamp_ns < 0 ? "-" : "";
-  const int64_t magnitude = std::llabs(stamp_ns);
-  char text[48];
-  std::snprintf(text, sizeof text, "%s%lld.%09lld", sign, static_cast<long long>(magnitude / kNsPerS),
-                static_cast<long long>(magnitude % kNsPerS));
-  return text;
-}
 
 json finite_or_null(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 json optional_or_null(const std::optional<double>& value) { return value ? json(*value) : json(nullptr); }
@@ -77,15 +69,15 @@ std::string joined(const std::vector<std::string>& parts, const std::string& sep
   return out;
 }
 
+// For people: fixed decimals, "n/a" where there is no value.
+std::string cell(double value, const char* pattern) { return std::isfinite(value) ? format(pattern, value) : "n/a"; }
+
 std::string summary(const Metrics& m) {
   return std::to_string(m.frames) + " frames; lateral RMSE " + format("%.3f", m.lateral_rmse_m) +
          " m, longitudinal RMSE " + format("%.3f", m.longitudinal_rmse_m) + " m, heading RMSE " +
          format("%.3f", m.heading_rmse_deg) + " deg, max position error " + format("%.3f", m.max_position_error_m) +
-         " m, latency p50 " + format("%.2f", m.latency_p50_ms) + " ms";
+         " m, latency p50 " + cell(m.latency_p50_ms, "%.2f ms") + ", coverage " + cell(100 * m.coverage, "%.1f%%");
 }
-
-// For people: fixed decimals, "n/a" where there is no value.
-std::string cell(double value, const char* pattern) { return std::isfinite(value) ? format(pattern, value) : "n/a"; }
 
 std::string markdown_cell(std::string s) {
   std::string out;
@@ -144,6 +136,8 @@ std::string metrics_json(const Metrics& m) {
       {"latency_p50_ms", finite_or_null(m.latency_p50_ms)},
       {"latency_p99_ms", finite_or_null(m.latency_p99_ms)},
       {"latency_max_ms", finite_or_null(m.latency_max_ms)},
+      {"coverage", finite_or_null(m.coverage)},
+      {"largest_gap_s", finite_or_null(m.largest_gap_s)},
       {"max_lane_offset_m", finite_or_null(m.max_lane_offset_m)},
       {"curb_hidden_fraction", finite_or_null(m.curb_hidden_fraction)},
       {"curb_hidden_fraction_max", finite_or_null(m.curb_hidden_fraction_max)},
@@ -153,7 +147,8 @@ std::string metrics_json(const Metrics& m) {
         {"heading_rmse_deg", optional_or_null(m.thresholds.heading_rmse_deg)},
         {"max_position_error_m", optional_or_null(m.thresholds.max_position_error_m)},
         {"max_lane_offset_m", optional_or_null(m.thresholds.max_lane_offset_m)},
-        {"settle_s", m.thresholds.settle_s}}},
+        {"settle_s", m.thresholds.settle_s},
+        {"min_coverage", optional_or_null(m.thresholds.min_coverage)}}},
       {"pass", m.pass},
       {"failures", m.failures},
   };
@@ -179,7 +174,7 @@ void write_errors_csv(const std::string& path, const ScoredRun& run, const std::
     const EstimateRecord& est = estimates.at(run.estimate_index.at(i));
     // A slightly negative variance from round-off is zero spread, not a NaN.
     auto sigma = [&](int k) { return std::sqrt(std::max(0.0, est.covariance(k, k))); };
-    text += seconds(e.stamp_ns) + ',' + number(e.lateral_m) + ',' + number(e.longitudinal_m) + ',' +
+    text += tum_seconds(e.stamp_ns) + ',' + number(e.lateral_m) + ',' + number(e.longitudinal_m) + ',' +
             number(e.heading_rad * kDegPerRad) + ',' + number(e.position_m) + ',' + number(e.estimate.x) + ',' +
             number(e.estimate.y) + ',' + number(e.estimate.yaw) + ',' + number(e.truth.x) + ',' + number(e.truth.y) +
             ',' + number(e.truth.yaw) + ',' + csv_field(est.status) + ',' + number(est.latency_ms) + ',' +
@@ -189,12 +184,8 @@ void write_errors_csv(const std::string& path, const ScoredRun& run, const std::
 }
 
 std::string tum_line(int64_t stamp_ns, const Pose2d& pose) {
-  // A rotation by yaw about z: q = (0, 0, sin(yaw/2), cos(yaw/2)).
-  const double qz = std::sin(pose.yaw / 2), qw = std::cos(pose.yaw / 2);
-  return seconds(stamp_ns) + ' ' + number(pose.x) + ' ' + number(pose.y) + " 0 0 0 " + number(qz) + ' ' + number(qw);
+  return tum_line(TumPose{stamp_ns, {pose.x, pose.y, 0}, ros2::yaw_quaternion(pose.yaw)});
 }
-
-static const char* const kTumHeader = "# timestamp x y z qx qy qz qw\n";
 
 void write_tum(const std::string& path, const std::vector<TruthPose>& poses) {
   std::string text = kTumHeader;
@@ -248,14 +239,14 @@ std::string comparison_markdown(const std::vector<Metrics>& runs) {
   std::string md =
       first +
       "| method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | max error m | latency p50 ms | "
-      "pass |\n" +
-      (several_scenarios ? "|---" : "") + "|---|---:|---:|---:|---:|---:|:---:|\n";
+      "coverage | pass |\n" +
+      (several_scenarios ? "|---" : "") + "|---|---:|---:|---:|---:|---:|---:|:---:|\n";
   for (const auto& m : runs) {
     if (several_scenarios) md += "| " + markdown_cell(m.scenario) + ' ';
     md += "| " + markdown_cell(m.method) + " | " + cell(m.lateral_rmse_m, "%.3f") + " | " +
           cell(m.longitudinal_rmse_m, "%.3f") + " | " + cell(m.heading_rmse_deg, "%.3f") + " | " +
           cell(m.max_position_error_m, "%.3f") + " | " + cell(m.latency_p50_ms, "%.2f") + " | " +
-          (m.pass ? "pass" : "FAIL") + " |\n";
+          cell(100 * m.coverage, "%.1f%%") + " | " + (m.pass ? "pass" : "FAIL") + " |\n";
   }
   return md;
 }

@@ -27,8 +27,9 @@ void write_metrics_json(const std::string& path, const Metrics& metrics);
 // by people and plotting scripts), both poses, the estimate's status, latency and standard deviations.
 void write_errors_csv(const std::string& path, const ScoredRun& run, const std::vector<EstimateRecord>& estimates);
 
-// TUM trajectory for evo: `t x y z qx qy qz qw`, t in seconds, 9 significant digits, z = 0, the yaw
-// as a rotation about z.
+// TUM trajectory for evo: `t x y z qx qy qz qw`, t in seconds, z = 0, the yaw as a rotation about z
+// (ros2::yaw_quaternion), every number exact (logs/tum_file.hpp), so `lidarloop score` reads back
+// the poses scored here.
 std::string tum_line(int64_t stamp_ns, const Pose2d& pose);
 void write_tum(const std::string& path, const std::vector<TruthPose>& poses);
 void write_tum(const std::string& path, const std::vector<EstimateRecord>& estimates);
@@ -39,7 +40,7 @@ std::string junit_xml(const std::vector<Metrics>& runs);
 void write_junit(const std::string& path, const std::vector<Metrics>& runs);
 
 // Like the paper's Table III: method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg |
-// max error m | latency p50 ms | pass. A scenario column is added when the runs span several.
+// max error m | latency p50 ms | coverage | pass. A scenario column is added when the runs span several.
 std::string comparison_markdown(const std::vector<Metrics>& runs);
 // The same columns (and always the scenario) with full precision.
 void write_comparison_csv(const std::string& path, const std::vector<Metrics>& runs);

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "localizer/driving_corridor.hpp"
+#include "logs/ros2_messages.hpp"
 #include "loop/birdseye.hpp"
 #include "loop/error_plots.hpp"
 #include "loop/result_files.hpp"
@@ -24,8 +25,11 @@ void write_worst_frame(const std::string& path, const WorstFrame& w, const HdMap
   title.precision(2);
   title << std::fixed << method << ": worst frame, position error " << w.error_m << " m";
   o.title = title.str();
-  o.marks = {{"curb features (placed at the estimate)", place(w.features.curbs), {0, 0, 255}},
-             {"obstacle points (placed at the estimate)", place(w.features.obstacles), {255, 0, 255}}};
+  // `score` has no features (the localizer under test is not ours): no legend for what is not drawn.
+  if (!w.features.curbs.empty())
+    o.marks.push_back({"curb features (placed at the estimate)", place(w.features.curbs), {0, 0, 255}});
+  if (!w.features.obstacles.empty())
+    o.marks.push_back({"obstacle points (placed at the estimate)", place(w.features.obstacles), {255, 0, 255}});
   o.poses = {{"ground truth", w.truth, {255, 255, 255}}, {"estimate", w.estimate, {0, 200, 255}}};
   write_birdseye_png(path, w.cloud, w.sensor_pose, map.curbs.map().curbs, o);
 }
@@ -44,17 +48,20 @@ std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate
   out.reserve(estimates.size());
   for (const auto& e : estimates)
     if (!(e.health & kNotInitialized))
-      out.push_back({e.stamp_ns, e.pose, e.covariance, describe_health(e.health), e.total_ms});
+      out.push_back({e.stamp_ns,
+                     {e.pose.x, e.pose.y, ros2::published_yaw(e.pose.yaw)},
+                     e.covariance,
+                     describe_health(e.health),
+                     e.total_ms});
   return out;
 }
 
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
-                          const Path& route, const std::vector<TruthSample>& truth_samples, const std::string& method,
-                          const std::vector<LocalizerEstimate>& all_estimates, const WorstFrame* worst,
-                          const HdMap& map, const std::vector<CurbVisibility>& curb_visibility) {
-  const std::vector<EstimateRecord> estimates = estimate_records(all_estimates);
-  const std::vector<TruthPose> truth = truth_poses(truth_samples);
-  ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name, curb_visibility);
+                          const Path& route, const std::vector<TruthPose>& truth, const std::string& method,
+                          const std::vector<EstimateRecord>& estimates, const WorstFrame* worst, const HdMap& map,
+                          const std::vector<CurbVisibility>& curb_visibility) {
+  ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name, curb_visibility,
+                           scenario.lidar.scan_period_ns());
   scored.metrics.realism = realism_name(scenario.realism);
   scored.metrics.realism_overrides = realism_overrides(scenario);
   const MountDraw mount = draw_mount_error(scenario.mount_error, scenario.seed);  // as the simulation drew it
@@ -71,6 +78,14 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
   write_trajectory_plot(dir + "/trajectory.png", truth, estimates, scored.errors, map.curbs.map().curbs);
   if (worst) write_worst_frame(dir + "/worst_frame.png", *worst, map, method);
   return scored;
+}
+
+ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
+                          const Path& route, const std::vector<TruthSample>& truth, const std::string& method,
+                          const std::vector<LocalizerEstimate>& estimates, const WorstFrame* worst, const HdMap& map,
+                          const std::vector<CurbVisibility>& curb_visibility) {
+  return score_and_write(dir, scenario_name, scenario, route, truth_poses(truth), method, estimate_records(estimates),
+                         worst, map, curb_visibility);
 }
 
 }  // namespace lidarloop

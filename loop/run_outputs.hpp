@@ -13,12 +13,23 @@ namespace lidarloop {
 // The scorer's plain inputs from the loop's records. The truth's stamped poses (the scorer needs no
 // speeds or steering):
 std::vector<TruthPose> truth_poses(const std::vector<TruthSample>& truth);
-// The estimates of an initialised localizer, with the health as words and the latency:
+// The estimates of an initialised localizer (the ones a recording logs), with the health as words
+// and the latency. The yaw is the published one (ros2::published_yaw: through the quaternion of the
+// log's Odometry and back), so the run scores what a reader of its log or its TUM export gets.
 std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate>& estimates);
 
 // Scores one method's run with the pure scorer (loop/scorer.hpp: the thresholds and settle time from
-// the scenario, lane keeping along `route`), then writes its files into `dir`. `worst` may be null (no
-// bird's-eye picture). `curb_visibility`: the simulator's per-scan records (empty when not known).
+// the scenario, lane keeping along `route`, coverage by the scenario's LiDAR scan period), then
+// writes its files into `dir`: metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml,
+// errors.png, trajectory.png, and worst_frame.png when `worst` is given (else none). `realism`,
+// the mount error and the thresholds come from `scenario`. `curb_visibility`: the simulator's
+// per-scan records (empty when not known). `run`, `compare`, `replay` and `score` all end here.
+ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
+                          const Path& route, const std::vector<TruthPose>& truth, const std::string& method,
+                          const std::vector<EstimateRecord>& estimates, const WorstFrame* worst, const HdMap& map,
+                          const std::vector<CurbVisibility>& curb_visibility);
+
+// The same from the loop's records (estimate_records, truth_poses).
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthSample>& truth, const std::string& method,
                           const std::vector<LocalizerEstimate>& estimates, const WorstFrame* worst, const HdMap& map,

@@ -34,6 +34,14 @@ void check(Metrics& m, const char* what, double value, const std::optional<doubl
   if (threshold && !(value <= *threshold)) m.failures.push_back(failure(what, value, *threshold, unit));
 }
 
+// A lower bound, e.g. "coverage 0.812 < 0.900".
+void check_at_least(Metrics& m, const char* what, double value, const std::optional<double>& threshold) {
+  if (!threshold || value >= *threshold) return;
+  char text[128];
+  std::snprintf(text, sizeof text, "%s %.3f < %.3f", what, value, *threshold);
+  m.failures.push_back(text);
+}
+
 }  // namespace
 
 FrameError frame_error(const Pose2d& truth, const Pose2d& estimate) {
@@ -64,6 +72,30 @@ Pose2d truth_at(const std::vector<TruthPose>& truth, int64_t t_ns) {
   const double f = double(t_ns - a.stamp_ns) / double(b.stamp_ns - a.stamp_ns);
   return {a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y),
           wrap_angle(a.pose.yaw + f * wrap_angle(b.pose.yaw - a.pose.yaw))};
+}
+
+Coverage estimate_coverage(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates,
+                           int64_t scan_period_ns) {
+  Coverage c;
+  if (truth.empty() || truth.back().stamp_ns <= truth.front().stamp_ns) return c;
+  const int64_t begin = truth.front().stamp_ns, end = truth.back().stamp_ns, half = scan_period_ns / 2;
+  std::vector<int64_t> stamps;
+  stamps.reserve(estimates.size());
+  for (const EstimateRecord& e : estimates) stamps.push_back(e.stamp_ns);
+  std::sort(stamps.begin(), stamps.end());
+  // Integer nanoseconds throughout: the same estimates give the same figures on every path.
+  int64_t covered = 0, gap = 0, reached = begin;  // the span is covered from `begin` to `reached`
+  for (int64_t t : stamps) {
+    const int64_t from = std::clamp(t - half, begin, end), to = std::clamp(t + half, begin, end);
+    if (to <= reached) continue;
+    gap = std::max(gap, from - reached);
+    covered += to - std::max(from, reached);
+    reached = to;
+  }
+  gap = std::max(gap, end - reached);
+  c.fraction = double(covered) / double(end - begin);
+  c.largest_gap_s = double(gap) / double(kNsPerS);
+  return c;
 }
 
 double rmse(const std::vector<double>& values) {
@@ -114,7 +146,7 @@ CurbOcclusion curb_occlusion(const std::vector<CurbVisibility>& scans) {
 
 ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates, const Path& route,
                 const PassThresholds& thresholds, const std::string& method, const std::string& scenario,
-                const std::vector<CurbVisibility>& curb_visibility) {
+                const std::vector<CurbVisibility>& curb_visibility, int64_t scan_period_ns) {
   if (!std::is_sorted(truth.begin(), truth.end(),
                       [](const TruthPose& a, const TruthPose& b) { return a.stamp_ns < b.stamp_ns; }))
     throw std::invalid_argument("score: ground truth is not sorted by stamp");
@@ -127,7 +159,7 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
   std::vector<double> lateral, longitudinal, heading_deg, position, latency;
   for (size_t i = 0; i < estimates.size(); ++i) {
     const EstimateRecord& est = estimates[i];
-    latency.push_back(est.latency_ms);
+    if (std::isfinite(est.latency_ms)) latency.push_back(est.latency_ms);
     if (truth.empty() || est.stamp_ns < truth.front().stamp_ns || est.stamp_ns > truth.back().stamp_ns) {
       ++m.unscored_frames;
       continue;
@@ -161,6 +193,9 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
   m.latency_p50_ms = percentile_nearest_rank(latency, kMedianPercent);
   m.latency_p99_ms = percentile_nearest_rank(latency, kTailPercent);
   m.latency_max_ms = latency.empty() ? kNaN : *std::max_element(latency.begin(), latency.end());
+  const Coverage coverage = estimate_coverage(truth, estimates, scan_period_ns);
+  m.coverage = coverage.fraction;
+  m.largest_gap_s = coverage.largest_gap_s;
   if (m.frames == 0) {
     m.max_position_error_m = m.max_lateral_m = m.max_longitudinal_m = m.max_heading_deg = kNaN;
     m.failures.push_back(estimates.empty() ? "no estimates" : "no estimates within the ground truth's time range");
@@ -169,6 +204,7 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
     check(m, "longitudinal RMSE", m.longitudinal_rmse_m, thresholds.longitudinal_rmse_m, "m");
     check(m, "heading RMSE", m.heading_rmse_deg, thresholds.heading_rmse_deg, "deg");
     check(m, "max position error", m.max_position_error_m, thresholds.max_position_error_m, "m");
+    check_at_least(m, "coverage", m.coverage, thresholds.min_coverage);
   }
   double lane_offset = truth.empty() ? kNaN : 0.0;
   for (double offset : lane_offsets(truth, route)) lane_offset = std::max(lane_offset, std::abs(offset));

@@ -38,7 +38,9 @@ struct EstimateRecord {
   Pose2d pose;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // x, y (m), yaw (rad)
   std::string status;                                    // the method's own word ("tracking", "gps only", ...)
-  double latency_ms = 0;                                 // wall time the localizer spent on this frame
+  // Wall time the localizer spent on this frame; NaN when not known (an estimate read from a file),
+  // and the latency metrics are then null rather than an invented 0.
+  double latency_ms = std::numeric_limits<double>::quiet_NaN();
 };
 
 // And, for the run's occlusion, the simulator's per-scan curb visibility (common/curb_visibility.hpp):
@@ -67,7 +69,11 @@ struct Metrics {
   double lateral_rmse_m = 0, longitudinal_rmse_m = 0, heading_rmse_deg = 0, position_rmse_m = 0;
   double max_position_error_m = 0, max_lateral_m = 0, max_longitudinal_m = 0, max_heading_deg = 0;  // absolute
   int64_t worst_frame_stamp_ns = 0;  // the frame with the largest position error (for a bird's-eye plot)
-  double latency_p50_ms = 0, latency_p99_ms = 0, latency_max_ms = 0;  // over every estimate
+  double latency_p50_ms = 0, latency_p99_ms = 0, latency_max_ms = 0;  // over every known latency; NaN: none
+  // How much of the truth's time span the estimates cover, and the longest stretch they leave
+  // uncovered, by the definition of estimate_coverage() below; NaN without a truth span.
+  double coverage = std::numeric_limits<double>::quiet_NaN();
+  double largest_gap_s = std::numeric_limits<double>::quiet_NaN();
   // The truth's largest distance from the route (its lane's centre) over the whole run; NaN without truth.
   double max_lane_offset_m = std::numeric_limits<double>::quiet_NaN();
   // How much of the curb in the localizer's range the traffic hid: hidden / (hidden + visible) curb
@@ -88,15 +94,20 @@ struct ScoredRun {
 
 // ---- The scorer ----
 
-// Scores every estimate whose stamp lies within the truth's time range and after the settling time,
-// and measures the truth's lane keeping along `route`. `method` and `scenario` only label the metrics.
-// Passes when there is at least one scored frame and every threshold that is set holds (a non-finite
-// value never holds). Throws std::invalid_argument if the truth is not sorted by stamp or the route
-// has fewer than two points. `curb_visibility` (one record per scan, any order) gives the curb
-// occlusion figures; it is not scored against any threshold.
+// Scores every estimate whose stamp lies within the truth's time range and after the settling time
+// (counted from the first estimate, scored or not), and measures the truth's lane keeping along
+// `route`. The estimates are aligned to the truth by time stamp only: the truth is interpolated at
+// each estimate's stamp, never the estimate, and there is no spatial alignment. So an estimate that
+// starts late, stops early or has gaps is scored on what exists; its coverage (estimate_coverage,
+// with the LiDAR's nominal `scan_period_ns`) says how much that is. `method` and `scenario` only
+// label the metrics. Passes when there is at least one scored frame and every threshold that is set
+// holds (a non-finite value never holds). Throws std::invalid_argument if the truth is not sorted by
+// stamp or the route has fewer than two points. `curb_visibility` (one record per scan, any order)
+// gives the curb occlusion figures; it is not scored against any threshold.
 ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates, const Path& route,
                 const PassThresholds& thresholds, const std::string& method, const std::string& scenario,
-                const std::vector<CurbVisibility>& curb_visibility = {});
+                const std::vector<CurbVisibility>& curb_visibility = {},
+                int64_t scan_period_ns = Hdl32eConfig{}.scan_period_ns());
 
 // ---- Its parts, pure as well ----
 
@@ -123,6 +134,24 @@ struct CurbOcclusion {
   double hidden_fraction_max = std::numeric_limits<double>::quiet_NaN();  // over scans with a sample in range
 };
 CurbOcclusion curb_occlusion(const std::vector<CurbVisibility>& scans);
+
+// Coverage. Each estimate covers the time within half a nominal scan period of its stamp
+// ([t - P/2, t + P/2], P = `scan_period_ns`, 100 ms for the HDL-32E at 10 Hz), so an estimate per
+// scan covers time without a hole however its stamps fall within the scan. The reference is the
+// truth's time span [first truth stamp, last truth stamp] (the drive, from its first to its last
+// instant):
+//   fraction      = |union of the estimates' intervals within the span| / |span|
+//   largest_gap_s = the longest stretch of the span in no estimate's interval, before the first
+//                   estimate and after the last included (0 when the span is covered; one missed
+//                   scan in a 10 Hz stream is a gap of one period)
+// A live run's estimates cover all but the first scans before the localizer is initialised. Both
+// NaN when the truth spans no time. The estimates' order does not matter.
+struct Coverage {
+  double fraction = std::numeric_limits<double>::quiet_NaN();
+  double largest_gap_s = std::numeric_limits<double>::quiet_NaN();
+};
+Coverage estimate_coverage(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates,
+                           int64_t scan_period_ns);
 
 // Root mean square; NaN for an empty list (there is nothing to measure, and 0 would read as perfect).
 double rmse(const std::vector<double>& values);

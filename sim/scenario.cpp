@@ -28,6 +28,19 @@ std::vector<Wait> read_waits(const YamlReader& y, const YAML::Node& n, const cha
   return out;
 }
 
+// A `pass` mapping over the values `pass` already holds.
+void read_pass(const YamlReader& y, const YAML::Node& n, PassThresholds& pass) {
+  YamlMap(y, n, "pass")
+      .number("lateral_rmse_m", pass.lateral_rmse_m, 0.0, 1e4)
+      .number("longitudinal_rmse_m", pass.longitudinal_rmse_m, 0.0, 1e4)
+      .number("heading_rmse_deg", pass.heading_rmse_deg, 0.0, 1e4)
+      .number("max_position_error_m", pass.max_position_error_m, 0.0, 1e4)
+      .number("max_lane_offset_m", pass.max_lane_offset_m, 0.0, 1e4)
+      .number("settle_s", pass.settle_s, 0.0, 60.0)
+      .number("min_coverage", pass.min_coverage, 0.0, 1.0)
+      .done();
+}
+
 // One of two words, as a bool: true for `yes`.
 bool read_choice(const YamlReader& y, const YAML::Node& n, const std::string& what, const char* no, const char* yes) {
   const std::string word = y.string(n, what);
@@ -239,14 +252,7 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   // The map's survey settings (loop/mapping_drive.hpp's read_survey_options), read with the map.
   if (const YAML::Node survey = root["survey"]) y.expect_map(survey, "survey");
   if (const YAML::Node loop = root["loop"]) s.closed_loop = read_choice(y, loop, "loop", "open", "closed");
-  YamlMap pass(y, root["pass"], "pass");
-  pass.number("lateral_rmse_m", s.pass.lateral_rmse_m, 0.0, 1e4)
-      .number("longitudinal_rmse_m", s.pass.longitudinal_rmse_m, 0.0, 1e4)
-      .number("heading_rmse_deg", s.pass.heading_rmse_deg, 0.0, 1e4)
-      .number("max_position_error_m", s.pass.max_position_error_m, 0.0, 1e4)
-      .number("max_lane_offset_m", s.pass.max_lane_offset_m, 0.0, 1e4)
-      .number("settle_s", s.pass.settle_s, 0.0, 60.0)
-      .done();
+  read_pass(y, root["pass"], s.pass);
   YamlMap(y, root["output"], "output").integer("scan_every", s.scan_every, 0, 1000000).done();
   root.done();
   return s;
@@ -292,6 +298,29 @@ Scenario load_scenario(const std::string& path, const VehicleParams& vehicle, st
 Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle,
                         std::optional<Realism> realism) {
   return parse(YamlReader::from_string(yaml_text, name), vehicle, realism);
+}
+
+PassThresholds load_pass_file(const std::string& path, const PassThresholds& base) {
+  const YamlReader y = YamlReader::open(path);
+  YamlMap root(y, y.root(), "the file");
+  PassThresholds pass = base;
+  read_pass(y, root.required("pass"), pass);
+  root.done();
+  return pass;
+}
+
+PassThresholds parse_pass_assignment(const std::string& assignment, const std::string& what,
+                                     const PassThresholds& base) {
+  const size_t eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == assignment.size())
+    throw InputError(what + ": expected KEY=VALUE (a key of a scenario's pass), got '" + assignment + "'");
+  // Read as the one-key mapping it stands for, so the keys, types and ranges are checked exactly as
+  // in a scenario; the error then points into "KEY: VALUE" (line 1), which is the argument itself.
+  const YamlReader y =
+      YamlReader::from_string(assignment.substr(0, eq) + ": " + assignment.substr(eq + 1), what + " " + assignment);
+  PassThresholds pass = base;
+  read_pass(y, y.root(), pass);
+  return pass;
 }
 
 namespace {

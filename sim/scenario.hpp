@@ -72,7 +72,19 @@ struct PassThresholds {
   // Estimates in the first settle_s seconds (from the first estimate) are not scored: the localizer
   // starts from one GPS fix that may be metres off, and its convergence is not its accuracy.
   double settle_s = 0;
+  // The least share of the truth's time span the estimates must cover (loop/scorer.hpp's coverage):
+  // an estimate that starts late, stops early or has gaps is scored on what exists, and this says
+  // how much must exist.
+  std::optional<double> min_coverage;
 };
+
+// Thresholds given apart from a scenario (`lidarloop score`), read as strictly as a scenario's
+// `pass`, each over `base` (keys present replace base's values):
+// a YAML file holding only a `pass:` mapping; InputError "file:line:col: ..." for anything else.
+PassThresholds load_pass_file(const std::string& path, const PassThresholds& base);
+// "key=value" with a key of `pass`; InputError naming `what` (e.g. "--threshold") and the problem.
+PassThresholds parse_pass_assignment(const std::string& assignment, const std::string& what,
+                                     const PassThresholds& base);
 
 struct Scenario {
   std::string file;

@@ -14,6 +14,7 @@
 #include "logs/ros2_messages.hpp"
 #include "loop/localizer_backend.hpp"
 #include "loop/localizer_setup.hpp"
+#include "loop/recorded_log.hpp"
 #include "loop/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "loop/run_recording.hpp"
@@ -24,46 +25,14 @@ namespace {
 
 namespace topics = log_topics;
 
-struct RecordedRun {
-  std::string scenario_text, scenario_name;
-  std::map<std::string, std::string> metadata;
-};
-
-// The scenario and the run's settings, which the recorder writes before the first chunk.
-RecordedRun recorded_run(const McapReader& reader, const std::string& log) {
-  RecordedRun run;
-  for (const auto& a : reader.attachments())
-    if (a.name == kScenarioAttachment) run.scenario_text.assign(a.data.begin(), a.data.end());
-  for (const auto& m : reader.metadata())
-    if (m.name == kRunMetadata) run.metadata.insert(m.metadata.begin(), m.metadata.end());
-  if (run.scenario_text.empty() || run.metadata.empty())
-    throw InputError(log + ": no " + kScenarioAttachment + " attachment or " + kRunMetadata +
-                     " metadata: not a log recorded by lidarloop run or simulate");
-  run.scenario_name = run.metadata.count("scenario") ? run.metadata.at("scenario") : log;
-  return run;
-}
-
 int run_replay(const Args& args) {
   const std::string log = args.positional().at(0);
   McapReader reader(log);
   McapMessage message;
   bool more = reader.next(message);
   const RecordedRun run = recorded_run(reader, log);
-
-  // The profile the run had (a --realism on its command line is not in the scenario's text).
-  std::optional<Realism> realism;
-  if (run.metadata.count("realism")) {
-    realism = parse_realism(run.metadata.at("realism"));
-    if (!realism) throw InputError(log + ": metadata " + kRunMetadata + " has an unknown realism profile");
-  }
-  Scenario scenario = parse_scenario(run.scenario_text, run.scenario_name,
-                                     load_vehicle_params(data_dir() + "/assets/vehicle.yaml"), realism);
-  try {
-    scenario.seed = std::stoull(run.metadata.at("seed"));
-  } catch (const std::exception&) {
-    throw InputError(log + ": metadata " + kRunMetadata + " has no valid seed");
-  }
-  const std::string recorded_method = run.metadata.count("method") ? run.metadata.at("method") : "";
+  const Scenario& scenario = run.scenario;
+  const std::string& recorded_method = run.method;
   std::optional<std::string> method = args.value("method");
   if (!method && !recorded_method.empty()) method = recorded_method;
   const LocalizerParams params = localizer_params_for(scenario, method);

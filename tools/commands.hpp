@@ -25,6 +25,7 @@ Command export_command();
 Command run_command();
 Command compare_command();
 Command replay_command();
+Command score_command();
 Command sweep_command();
 int run_bench_map(const Args& args);
 int run_bench_localizer(const Args& args);

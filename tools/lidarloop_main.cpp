@@ -8,9 +8,9 @@
 using namespace lidarloop;
 
 static std::vector<Command> commands() {
-  return {world_command(),   scan_command(),   validate_command(), simulate_command(), run_command(),
-          compare_command(), replay_command(), map_command(),      info_command(),     export_command(),
-          recover_command(), bench_command(),  sweep_command()};
+  return {world_command(),   scan_command(),    validate_command(), simulate_command(), run_command(),
+          compare_command(), replay_command(),  score_command(),    map_command(),      info_command(),
+          export_command(),  recover_command(), bench_command(),    sweep_command()};
 }
 
 static void print_usage(std::ostream& out) {

@@ -21,6 +21,7 @@
 #include "logs/mcap/zstd_codec.hpp"
 #include "logs/ros2_messages.hpp"
 #include "logs/ros2_schemas.hpp"
+#include "logs/tum_file.hpp"
 #include "mcap_fixture.hpp"
 
 namespace lidarloop {
@@ -555,12 +556,16 @@ TEST_F(McapLog, ExportsTumPcdAndKitti) {
   const ExportResult poses = export_tum(*path_, tum);
   EXPECT_EQ(poses.topic, topics::estimate);  // the estimate when there is one
   ASSERT_EQ(poses.count, run_->estimates.size());
-  std::ifstream in(tum);
-  double t, x, y, z, qx, qy, qz, qw;
-  ASSERT_TRUE(in >> t >> x >> y >> z >> qx >> qy >> qz >> qw);
-  EXPECT_NEAR(t, double(run_->estimates[0].stamp_ns) * 1e-9, 1e-12);
-  EXPECT_NEAR(x, run_->estimates[0].pose.x, 1e-8);
-  EXPECT_NEAR(2 * std::atan2(qz, qw), run_->estimates[0].pose.yaw, 1e-9);
+  // Exact: every stamp, coordinate and quaternion reads back as written to the log (logs/tum_file.hpp).
+  const Bytes text = read_file(tum);
+  const std::vector<TumPose> exported = parse_tum(std::string(text.begin(), text.end()), tum);
+  ASSERT_EQ(exported.size(), run_->estimates.size());
+  for (size_t i = 0; i < exported.size(); ++i) {
+    EXPECT_EQ(exported[i].stamp_ns, run_->estimates[i].stamp_ns);
+    EXPECT_EQ(exported[i].position.x(), run_->estimates[i].pose.x);
+    EXPECT_EQ(exported[i].position.y(), run_->estimates[i].pose.y);
+    EXPECT_EQ(ros2::yaw_of(exported[i].orientation), ros2::published_yaw(run_->estimates[i].pose.yaw));
+  }
   EXPECT_EQ(export_tum(*path_, tum, std::string(topics::truth_odometry)).count, run_->truth.size());
   EXPECT_THROW(export_tum(*path_, tum, "/nothing"), InputError);
 

@@ -300,10 +300,10 @@ TEST(ResultFiles, TumLineFormat) {
   for (double x; in >> x;) v.push_back(x);
   ASSERT_EQ(v.size(), 8u);
   EXPECT_DOUBLE_EQ(v[0], 123.456789012);
-  EXPECT_NEAR(v[1], 1234.56789, 1e-9);  // 9 significant digits
+  EXPECT_EQ(v[1], 1234.56789012);  // exact: the shortest text that reads back as the same double
   EXPECT_EQ(v[3], 0);
-  EXPECT_NEAR(v[6], std::sin(kPi / 4), 1e-9);
-  EXPECT_NEAR(v[7], std::cos(kPi / 4), 1e-9);
+  EXPECT_EQ(v[6], std::sin(kPi / 4));
+  EXPECT_EQ(v[7], std::cos(kPi / 4));
 
   const std::string path = temp_path("truth.tum");
   write_tum(path, straight_truth(1));
@@ -347,7 +347,7 @@ TEST(ResultFiles, ComparisonTableAndCsv) {
   EXPECT_NE(
       md.find("| method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | max error m | latency p50 ms"),
       std::string::npos);
-  EXPECT_NE(md.find("| proposed | 0.050 | 0.100 | 0.000 | 0.112 | 5.00 | pass |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| proposed | 0.050 | 0.100 | 0.000 | 0.112 | 5.00 | 100.0% | pass |"), std::string::npos) << md;
   EXPECT_NE(md.find("| icp | 0.500 | 2.500 |"), std::string::npos) << md;
   EXPECT_NE(md.find("FAIL"), std::string::npos);
   const std::string path = temp_path("compare.csv");

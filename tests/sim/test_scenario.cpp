@@ -1,5 +1,8 @@
 // The scenario format: a valid scenario loads with its values; every malformed one is rejected with
 // its own message at the right line and column.
+#include <fstream>
+#include <functional>
+
 #include <gtest/gtest.h>
 
 #include "sim/scenario.hpp"
@@ -97,6 +100,8 @@ TEST(Scenario, MalformedScenariosAreRejectedWithTheirOwnMessage) {
       {"unknown method", edit("{method: icp-obs}", "{method: slam}"), "19:21", "unknown localizer method 'slam'"},
       {"bad loop", edit("loop: closed", "loop: maybe"), "20:7", "loop must be open or closed"},
       {"unknown threshold", edit("heading_rmse_deg", "heading_rms_deg"), "21:29", "unknown key 'heading_rms_deg'"},
+      {"coverage above 1", edit("heading_rmse_deg: 0.3", "min_coverage: 1.5"), "21:43",
+       "min_coverage = 1.5 is out of range"},
       {"duplicate key", edit("seed: 3\n", "seed: 3\nseed: 4\n"), "4:1", "key 'seed' appears twice"},
       {"unknown realism", edit("seed: 3\n", "seed: 3\nrealism: gritty\n"), "4:10",
        "realism must be ideal, typical or harsh, got 'gritty'"},
@@ -172,6 +177,39 @@ TEST_F(ScenarioOnCampus, PathsOffTheRoadNetworkAreRejected) {
                        "the actor's path leaves the road network");
   expect_resolve_error(edit("{crosswalk: 1}", "{crosswalk: 40}"), "17:30", "there is no crosswalk 40");
   expect_resolve_error(edit("position: [303, 120]", "position: [5000, 120]"), "18:5", "outside the world");
+}
+
+// Thresholds given apart from a scenario (lidarloop score): a file with a `pass:` mapping and
+// KEY=VALUE arguments, each over what came before and as strictly checked as a scenario's.
+TEST(Scenario, PassThresholdsFromAFileAndFromArguments) {
+  const Scenario s = parse_scenario(kValid, "valid.yaml");
+  EXPECT_FALSE(s.pass.min_coverage.has_value());
+  const std::string path = testing::TempDir() + "pass.yaml";
+  std::ofstream(path) << "pass: {min_coverage: 0.9, lateral_rmse_m: 0.2}\n";
+  PassThresholds p = load_pass_file(path, s.pass);
+  EXPECT_EQ(p.min_coverage, 0.9);
+  EXPECT_EQ(p.lateral_rmse_m, 0.2);    // replaced
+  EXPECT_EQ(p.heading_rmse_deg, 0.3);  // kept from the scenario
+  p = parse_pass_assignment("settle_s=1.5", "--threshold", p);
+  EXPECT_EQ(p.settle_s, 1.5);
+  EXPECT_EQ(p.min_coverage, 0.9);
+
+  auto fails = [&](const std::function<void()>& f, const std::string& expected) {
+    try {
+      f();
+      ADD_FAILURE() << expected << ": accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  fails([&] { parse_pass_assignment("lateral_rmse_m", "--threshold", {}); }, "--threshold: expected KEY=VALUE");
+  fails([&] { parse_pass_assignment("lateral=1", "--threshold", {}); }, "unknown key 'lateral'");
+  fails([&] { parse_pass_assignment("min_coverage=2", "--threshold", {}); }, "min_coverage = 2 is out of range");
+  fails([&] { parse_pass_assignment("settle_s=soon", "--threshold", {}); }, "settle_s must be a finite number");
+  std::ofstream(path) << "pass: {min_coverage: 0.9}\nseed: 3\n";
+  fails([&] { load_pass_file(path, {}); }, "pass.yaml:2:1: unknown key 'seed'");
+  std::ofstream(path) << "thresholds: {}\n";
+  fails([&] { load_pass_file(path, {}); }, "missing key 'pass'");
 }
 
 }  // namespace

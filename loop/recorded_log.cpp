@@ -1,0 +1,71 @@
+#include "loop/recorded_log.hpp"
+
+#include "common/input_error.hpp"
+#include "logs/log_topics.hpp"
+#include "logs/ros2_messages.hpp"
+#include "loop/run_recording.hpp"
+#include "sim/vehicle_model.hpp"
+#include "sim/world_assets.hpp"
+
+namespace lidarloop {
+
+namespace topics = log_topics;
+
+RecordedRun recorded_run(const McapReader& reader, const std::string& log) {
+  RecordedRun run;
+  for (const auto& a : reader.attachments())
+    if (a.name == kScenarioAttachment) run.scenario_text.assign(a.data.begin(), a.data.end());
+  for (const auto& m : reader.metadata())
+    if (m.name == kRunMetadata) run.metadata.insert(m.metadata.begin(), m.metadata.end());
+  if (run.scenario_text.empty() || run.metadata.empty())
+    throw InputError(log + ": no " + kScenarioAttachment + " attachment or " + kRunMetadata +
+                     " metadata: not a log recorded by lidarloop run or simulate");
+  run.scenario_name = run.metadata.count("scenario") ? run.metadata.at("scenario") : log;
+  run.method = run.metadata.count("method") ? run.metadata.at("method") : "";
+
+  // The profile the run had (a --realism on its command line is not in the scenario's text).
+  std::optional<Realism> realism;
+  if (run.metadata.count("realism")) {
+    realism = parse_realism(run.metadata.at("realism"));
+    if (!realism) throw InputError(log + ": metadata " + kRunMetadata + " has an unknown realism profile");
+  }
+  run.scenario = parse_scenario(run.scenario_text, run.scenario_name,
+                                load_vehicle_params(data_dir() + "/assets/vehicle.yaml"), realism);
+  try {
+    run.scenario.seed = std::stoull(run.metadata.at("seed"));
+  } catch (const std::exception&) {
+    throw InputError(log + ": metadata " + kRunMetadata + " has no valid seed");
+  }
+  return run;
+}
+
+RecordedLog read_recorded_log(const std::string& log) {
+  McapReader reader(log);
+  RecordedLog out;
+  for (McapMessage message; reader.next(message);) {
+    const std::string& topic = message.channel->topic;
+    const std::string context = log + " " + topic;
+    if (topic == topics::truth_state)
+      out.truth.push_back(ros2::decode_truth_state(message.data, context));
+    else if (topic == topics::truth_curb_visibility)
+      out.curb_visibility.push_back(ros2::decode_curb_visibility(message.data, context));
+  }
+  out.run = recorded_run(reader, log);
+  if (out.truth.empty())
+    throw InputError(log + ": no " + std::string(topics::truth_state) + " messages to score against");
+  return out;
+}
+
+std::optional<PointCloud> recorded_scan_before(const std::string& log, int64_t stamp_ns) {
+  McapReader reader(log);
+  std::optional<PointCloud> found;
+  for (McapMessage message; reader.next(message);) {
+    if (message.channel->topic != topics::scan) continue;
+    PointCloud cloud = ros2::decode_point_cloud(message.data, log + " " + topics::scan);
+    if (found && cloud.stamp_ns > stamp_ns) break;  // the first scan, or the latest at or before
+    found = std::move(cloud);
+  }
+  return found;
+}
+
+}  // namespace lidarloop
