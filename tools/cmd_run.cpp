@@ -108,6 +108,8 @@ int run_run(const Args& args) {
   std::printf("localizer  %zu scans, %.2f ms per scan on average, %.1f%% of the loop's time\n", r.scans,
               1e3 * r.localizer_wall_s / double(std::max<size_t>(r.scans, 1)), 100 * r.localizer_wall_s / r.wall_s);
   std::printf("lane       the car stayed within %.2f m of its lane's centre\n", lane_offset);
+  std::printf("coverage   %.1f%% of the drive had an estimate (largest gap %.2f s)\n", 100 * scored.metrics.coverage,
+              scored.metrics.largest_gap_s);
   size_t with_obstacles = 0;
   for (const auto& e : trace.estimates) with_obstacles += e.obstacle_points >= kObstacleScanPoints;
   std::printf("obstacles  in the corridor in %zu of %zu scans (%.0f%%)\n", with_obstacles, trace.estimates.size(),
