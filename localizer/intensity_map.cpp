@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <charconv>
 #include <climits>
 #include <cmath>
 #include <filesystem>
@@ -19,6 +18,7 @@
 #include "common/input_error.hpp"
 #include "common/little_endian.hpp"
 #include "common/yaml_reader.hpp"
+#include "localizer/map_files.hpp"
 
 namespace lidarloop {
 namespace {
@@ -79,13 +79,6 @@ std::string tile_name(int tx, int ty) {
   std::string name = "(";
   name.append(std::to_string(tx)).append(", ").append(std::to_string(ty)).append(")");
   return name;
-}
-
-// Shortest decimal that reads back to the same double: 0.2 stays "0.2" for people, lat/lon stay exact.
-std::string shortest(double v) {
-  std::array<char, 64> buf{};
-  const auto result = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  return std::string(buf.data(), result.ptr);
 }
 
 void check_geometry(const IntensityMapHeader& h, const char* who) {
@@ -161,20 +154,6 @@ std::string encode_tile(int tx, int ty, int tile_cells, const std::vector<Intens
   return out;
 }
 
-// Writes to a temporary name and renames it over `path`, so a reader never sees half a file.
-void write_file_atomically(const fs::path& path, const std::string& bytes) {
-  const fs::path temp = path.string() + kTempSuffix;
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    out.close();
-    if (!out) throw InputError(temp.string() + ": cannot write file");
-  }
-  std::error_code ec;
-  fs::rename(temp, path, ec);
-  if (ec) throw InputError(path.string() + ": cannot write file: " + ec.message());
-}
-
 // Plain scalars for people; yaml-cpp quotes the ones that would read back as something else ("null", "").
 std::string header_yaml(const IntensityMapHeader& h) {
   YAML::Emitter out;
@@ -184,14 +163,14 @@ std::string header_yaml(const IntensityMapHeader& h) {
   out << YAML::Key << "world" << YAML::Value << h.world;
   out << YAML::Key << "world_hash" << YAML::Value << h.world_hash;
   out << YAML::Key << "origin" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "lat" << YAML::Value << shortest(h.origin.lat_deg);
-  out << YAML::Key << "lon" << YAML::Value << shortest(h.origin.lon_deg);
-  out << YAML::Key << "alt" << YAML::Value << shortest(h.origin.alt_m);
+  out << YAML::Key << "lat" << YAML::Value << shortest_decimal(h.origin.lat_deg);
+  out << YAML::Key << "lon" << YAML::Value << shortest_decimal(h.origin.lon_deg);
+  out << YAML::Key << "alt" << YAML::Value << shortest_decimal(h.origin.alt_m);
   out << YAML::EndMap;
   out << YAML::Key << "projection" << YAML::Value << kProjection;
-  out << YAML::Key << "resolution_m" << YAML::Value << shortest(h.resolution_m);
+  out << YAML::Key << "resolution_m" << YAML::Value << shortest_decimal(h.resolution_m);
   out << YAML::Key << "tile_cells" << YAML::Value << h.tile_cells;
-  out << YAML::Key << "tile_size_m" << YAML::Value << shortest(h.tile_size_m());
+  out << YAML::Key << "tile_size_m" << YAML::Value << shortest_decimal(h.tile_size_m());
   out << YAML::Key << "build" << YAML::Value << YAML::BeginMap;
   for (const auto& [key, value] : h.build) out << YAML::Key << key << YAML::Value << value;
   out << YAML::EndMap;
@@ -480,7 +459,7 @@ IntensityMapHeader read_intensity_map_header(const std::string& dir) {
   const double size = yaml.number(tile_size, "tile_size_m");
   if (std::fabs(size - h.tile_size_m()) > kTileSizeRelativeTolerance * h.tile_size_m())
     yaml.fail(tile_size, "tile_size_m = " + tile_size.Scalar() +
-                             " does not match resolution_m * tile_cells = " + shortest(h.tile_size_m()));
+                             " does not match resolution_m * tile_cells = " + shortest_decimal(h.tile_size_m()));
 
   const YAML::Node build = root.required("build");
   yaml.expect_map(build, "build");
