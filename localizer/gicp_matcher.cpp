@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Dense>
 #include <open3d/geometry/KDTreeSearchParam.h>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/GeneralizedICP.h>
 #include <open3d/pipelines/registration/Registration.h>
 #include <open3d/utility/Logging.h>
+#include <Eigen/Dense>
 
 namespace lidarloop {
 

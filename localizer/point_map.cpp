@@ -246,8 +246,8 @@ std::vector<Eigen::Vector3f> read_point_tile(const std::string& file, const std:
   const uint64_t count = word(bytes, 16);
   const uint64_t expected = kTileHeaderBytes + count * kPointBytes + kWordBytes;
   if (bytes.size() != expected)
-    throw InputError(file + ": truncated or overlong point map tile (" + std::to_string(bytes.size()) +
-                     " bytes, its " + std::to_string(count) + " points need " + std::to_string(expected) + ")");
+    throw InputError(file + ": truncated or overlong point map tile (" + std::to_string(bytes.size()) + " bytes, its " +
+                     std::to_string(count) + " points need " + std::to_string(expected) + ")");
   const uint32_t stored = word(bytes, expected - kWordBytes), computed = crc32(bytes.data(), expected - kWordBytes);
   if (stored != computed) {
     std::ostringstream msg;

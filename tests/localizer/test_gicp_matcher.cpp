@@ -146,7 +146,8 @@ TEST(GicpMatcher, BadInputGivesAStatusNotACrash) {
   EXPECT_EQ(gicp_match(all_nan, prior, target, p, 1.0).status, GicpStatus::few_scan_points);
   // NaN among good points: dropped, the match still works.
   std::vector<Eigen::Vector3d> mixed = scan_from(prior);
-  for (size_t i = 0; i < mixed.size(); i += 10) mixed[i] = Eigen::Vector3d(nan, 1, std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < mixed.size(); i += 10)
+    mixed[i] = Eigen::Vector3d(nan, 1, std::numeric_limits<double>::infinity());
   EXPECT_TRUE(gicp_match(mixed, prior, target, p, 1.0).ok());
   // No map (an empty target, or one of NaN): no match.
   EXPECT_EQ(gicp_match(scan_from(prior), prior, GicpTarget(), p, 1.0).status, GicpStatus::few_map_points);
