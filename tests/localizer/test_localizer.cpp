@@ -180,6 +180,25 @@ TEST(Localizer, GpsOnlyMethodKeepsTheGpsOffset) {
   EXPECT_GT(std::hypot(e.pose.x - truth.x, e.pose.y - truth.y), 1.0);  // nothing removes the bias
 }
 
+TEST(Localizer, GicpWithoutAPointLayerSaysSoAndKeepsTheFilterGoing) {
+  // This map has no point-cloud layer (a map folder of format 4 or older): gicp has nothing to match,
+  // flags every scan and carries on with CAN and GPS.
+  LocalizerParams p = test_params();
+  p.method = LocalizerMethod::gicp;
+  Localizer localizer(shared_map(), p);
+  DriveOptions o;
+  o.duration_s = 2;
+  const auto run = drive(localizer, o);
+  ASSERT_FALSE(run.empty());
+  for (const auto& [e, truth] : run) {
+    ASSERT_TRUE(finite(e));
+    if (!(e.health & kNotInitialized)) {
+      EXPECT_TRUE(e.health & kNoPointMatch) << describe_health(e.health);
+    }
+  }
+  EXPECT_NE(describe_health(kNoPointMatch | kPointMatchRejected).find("point match rejected"), std::string::npos);
+}
+
 TEST(Localizer, NoPoseBeforeTheFirstFix) {
   Localizer localizer(shared_map(), test_params());
   std::mt19937_64 rng(1);
