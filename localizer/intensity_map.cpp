@@ -75,12 +75,6 @@ std::string tile_file_name(int tx, int ty) {
   return name;
 }
 
-std::string tile_name(int tx, int ty) {
-  std::string name = "(";
-  name.append(std::to_string(tx)).append(", ").append(std::to_string(ty)).append(")");
-  return name;
-}
-
 void check_geometry(const IntensityMapHeader& h, const char* who) {
   if (!(std::isfinite(h.resolution_m) && h.resolution_m > 0))
     throw std::invalid_argument(std::string(who) + ": resolution_m must be a positive number");
@@ -107,9 +101,6 @@ std::optional<int64_t> global_cell(double coord, double resolution, int tile_cel
   if (cell < lo || cell > hi) return std::nullopt;
   return static_cast<int64_t>(cell);
 }
-
-// Floor division: C++ '/' truncates towards zero, which would fold tiles -1 and 0 together.
-int64_t floor_div(int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
 
 std::optional<CellIndex> try_cell_index(const IntensityMapHeader& h, const Eigen::Vector2d& xy) {
   const auto gx = global_cell(xy.x(), h.resolution_m, h.tile_cells);
@@ -429,14 +420,7 @@ IntensityMapHeader read_intensity_map_header(const std::string& dir) {
   YamlMap root(yaml, yaml.root(), "intensity map header");
   IntensityMapHeader h;
 
-  const YAML::Node format = root.required("format");
-  if (yaml.string(format, "format") != kFormatName)
-    yaml.fail(format, "format is '" + format.Scalar() + "', expected '" + kFormatName + "'");
-  const YAML::Node version = root.required("version");
-  const long v = yaml.integer_in(version, "version", LONG_MIN, LONG_MAX);
-  if (v != kFormatVersion)
-    yaml.fail(version,
-              "unsupported version " + std::to_string(v) + " (expected " + std::to_string(kFormatVersion) + ")");
+  read_format_and_version(yaml, root, kFormatName, kFormatVersion);
 
   h.world = yaml.string(root.required("world"), "world");
   h.world_hash = yaml.string(root.required("world_hash"), "world_hash");
@@ -468,16 +452,7 @@ IntensityMapHeader read_intensity_map_header(const std::string& dir) {
 
   const YAML::Node tiles = root.required("tiles");
   root.done();
-  yaml.expect_sequence(tiles, "tiles");
-  std::set<std::pair<int, int>> seen;
-  for (const YAML::Node& t : tiles) {
-    if (!t.IsSequence() || t.size() != 2) yaml.fail(t, "a tile must be [ix, iy]");
-    const std::pair<int, int> key{int(yaml.integer_in(t[0], "tile ix", INT_MIN, INT_MAX)),
-                                  int(yaml.integer_in(t[1], "tile iy", INT_MIN, INT_MAX))};
-    if (!seen.insert(key).second) yaml.fail(t, "tile " + tile_name(key.first, key.second) + " is listed twice");
-    h.tiles.push_back(key);
-  }
-  std::sort(h.tiles.begin(), h.tiles.end());
+  h.tiles = read_tile_list(yaml, tiles);
   return h;
 }
 

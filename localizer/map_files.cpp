@@ -1,8 +1,11 @@
 #include "localizer/map_files.hpp"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
+#include <climits>
 #include <fstream>
+#include <set>
 
 #include "common/input_error.hpp"
 
@@ -40,5 +43,38 @@ std::string shortest_decimal(double v) {
   const auto result = std::to_chars(buf.data(), buf.data() + buf.size(), v);
   return std::string(buf.data(), result.ptr);
 }
+
+void read_format_and_version(const YamlReader& yaml, YamlMap& root, const std::string& name, long version) {
+  const YAML::Node format = root.required("format");
+  if (yaml.string(format, "format") != name)
+    yaml.fail(format, "format is '" + format.Scalar() + "', expected '" + name + "'");
+  const YAML::Node v = root.required("version");
+  const long found = yaml.integer_in(v, "version", LONG_MIN, LONG_MAX);
+  if (found != version)
+    yaml.fail(v, "unsupported version " + std::to_string(found) + " (expected " + std::to_string(version) + ")");
+}
+
+std::vector<std::pair<int, int>> read_tile_list(const YamlReader& yaml, const YAML::Node& tiles) {
+  yaml.expect_sequence(tiles, "tiles");
+  std::vector<std::pair<int, int>> out;
+  std::set<std::pair<int, int>> seen;
+  for (const YAML::Node& t : tiles) {
+    if (!t.IsSequence() || t.size() != 2) yaml.fail(t, "a tile must be [ix, iy]");
+    const std::pair<int, int> key{int(yaml.integer_in(t[0], "tile ix", INT_MIN, INT_MAX)),
+                                  int(yaml.integer_in(t[1], "tile iy", INT_MIN, INT_MAX))};
+    if (!seen.insert(key).second) yaml.fail(t, "tile " + tile_name(key.first, key.second) + " is listed twice");
+    out.push_back(key);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::string tile_name(int tx, int ty) {
+  std::string name = "(";
+  name.append(std::to_string(tx)).append(", ").append(std::to_string(ty)).append(")");
+  return name;
+}
+
+int64_t floor_div(int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
 
 }  // namespace lidarloop

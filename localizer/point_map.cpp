@@ -50,13 +50,7 @@ std::array<int64_t, 3> unpack(uint64_t key) {
 }
 bool in_range(int64_t i) { return i >= -kAxisOffset && i < kAxisOffset; }
 
-int64_t floor_div(int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
-
-std::string tile_name(const std::pair<int, int>& key) {
-  std::string name = "(";
-  name.append(std::to_string(key.first)).append(", ").append(std::to_string(key.second)).append(")");
-  return name;
-}
+std::string tile_name(const std::pair<int, int>& key) { return lidarloop::tile_name(key.first, key.second); }
 
 void check_header(const PointMapHeader& h, const char* who) {
   if (!(h.voxel_m >= kMinVoxel && h.voxel_m <= kMaxVoxel))
@@ -207,30 +201,14 @@ PointMapHeader read_point_map_header(const std::string& dir) {
   const YamlReader yaml = YamlReader::open((fs::path(dir) / kHeaderFile).string());
   YamlMap root(yaml, yaml.root(), "point map header");
   PointMapHeader h;
-  const YAML::Node format = root.required("format");
-  if (yaml.string(format, "format") != kFormatName)
-    yaml.fail(format, "format is '" + format.Scalar() + "', expected '" + kFormatName + "'");
-  const YAML::Node version = root.required("version");
-  const long v = yaml.integer_in(version, "version", LONG_MIN, LONG_MAX);
-  if (v != kFormatVersion)
-    yaml.fail(version,
-              "unsupported version " + std::to_string(v) + " (expected " + std::to_string(kFormatVersion) + ")");
+  read_format_and_version(yaml, root, kFormatName, kFormatVersion);
   h.world = yaml.string(root.required("world"), "world");
   h.world_hash = yaml.string(root.required("world_hash"), "world_hash");
   h.voxel_m = yaml.number_in(root.required("voxel_m"), "voxel_m", kMinVoxel, kMaxVoxel);
   h.tile_voxels = int(yaml.integer_in(root.required("tile_voxels"), "tile_voxels", 1, kMaxTileVoxels));
   const YAML::Node tiles = root.required("tiles");
   root.done();
-  yaml.expect_sequence(tiles, "tiles");
-  std::set<std::pair<int, int>> seen;
-  for (const YAML::Node& t : tiles) {
-    if (!t.IsSequence() || t.size() != 2) yaml.fail(t, "a tile must be [ix, iy]");
-    const std::pair<int, int> key{int(yaml.integer_in(t[0], "tile ix", INT_MIN, INT_MAX)),
-                                  int(yaml.integer_in(t[1], "tile iy", INT_MIN, INT_MAX))};
-    if (!seen.insert(key).second) yaml.fail(t, "tile " + tile_name(key) + " is listed twice");
-    h.tiles.push_back(key);
-  }
-  std::sort(h.tiles.begin(), h.tiles.end());
+  h.tiles = read_tile_list(yaml, tiles);
   return h;
 }
 
