@@ -340,6 +340,16 @@ TEST(LocalizerParams, ReadsOverridesAndRejectsUnknownKeys) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml:2:21: unknown key 'alpah'"), std::string::npos) << e.what();
   }
+  const YamlReader gicp = YamlReader::from_string(
+      "localizer:\n  method: gicp\n  gicp: {scan_voxel_m: 0.8, max_iterations: 12, min_fitness: 0.4}\n", "g.yaml");
+  read_localizer_params(gicp, gicp.root()["localizer"], p);
+  EXPECT_EQ(p.method, LocalizerMethod::gicp);
+  EXPECT_EQ(p.gicp.scan_voxel_m, 0.8);
+  EXPECT_EQ(p.gicp.max_iterations, 12);
+  EXPECT_EQ(p.gicp.min_fitness, 0.4);
+  EXPECT_FALSE(removes_obstacles(LocalizerMethod::gicp));
+  const YamlReader bad_gicp = YamlReader::from_string("localizer:\n  gicp: {voxel: 0.5}\n", "bg.yaml");
+  EXPECT_THROW(read_localizer_params(bad_gicp, bad_gicp.root()["localizer"], p), InputError);
   const YamlReader method = YamlReader::from_string("localizer: {method: magic}\n", "m.yaml");
   EXPECT_THROW(read_localizer_params(method, method.root()["localizer"], p), InputError);
 }
