@@ -61,6 +61,9 @@ struct GicpParams {
   // of the prior, kept (with covariances) until the prior moves target_reuse_m from where it was
   // cut, so covariances are estimated about once a second at 10 m/s, not every scan.
   double target_reuse_m = 10.0;
+  // A new target keeps the old one's covariances of the points they share, but for those within this
+  // of the old one's edge (their neighbours were cut off there): 2 m, twice the reach of 20 neighbours.
+  double covariance_reuse_margin_m = 2.0;
   // Health: fewer scan points after downsampling, or fewer map points in the target, and there is no
   // match; a match with a smaller fraction of scan points within max correspondence of the map
   // (Open3D's fitness) is refused: the scan is then mostly what the map does not know (traffic, a

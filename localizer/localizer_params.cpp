@@ -117,6 +117,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("converged_translation_m", p.gicp.converged_translation_m, 0.0, 100.0)
       .number("converged_rotation_rad", p.gicp.converged_rotation_rad, 0.0, 3.2)
       .number("target_reuse_m", p.gicp.target_reuse_m, 0.0, 1000.0)
+      .number("covariance_reuse_margin_m", p.gicp.covariance_reuse_margin_m, 0.0, 1000.0)
       .integer("min_scan_points", p.gicp.min_scan_points, 0, 10000000)
       .integer("min_map_points", p.gicp.min_map_points, 0, 100000000)
       .number("min_fitness", p.gicp.min_fitness, 0.0, 1.0)

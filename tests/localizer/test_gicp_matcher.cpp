@@ -158,6 +158,22 @@ TEST(GicpMatcher, BadInputGivesAStatusNotACrash) {
   EXPECT_FALSE(gicp_match(elsewhere, prior, target, p, 1.0).ok());
 }
 
+TEST(GicpMatcher, ATargetCutAnewKeepsCovariancesThatAreTheSameAsFresh) {
+  // A target built after another one nearby keeps the covariances the two share; they must be exactly
+  // the ones a fresh build computes (same map points, same neighbours), so the match is the same.
+  const GicpParams p = test_params();
+  const std::vector<Eigen::Vector3d> map = street(0.2, 0.05, 7), scan = scan_from(pose(3.0, 1.0, 4.0));
+  GicpTarget fresh, reused;
+  fresh.build(map, {5, 0}, p);
+  reused.build(map, {0, 0}, p);
+  reused.build(map, {5, 0}, p);
+  const GicpResult a = gicp_match(scan, pose(3.3, 0.8, 5.5), fresh, p, 1.0);
+  const GicpResult b = gicp_match(scan, pose(3.3, 0.8, 5.5), reused, p, 1.0);
+  ASSERT_TRUE(a.ok());
+  EXPECT_TRUE(a.pose.matrix() == b.pose.matrix());
+  EXPECT_TRUE(a.covariance == b.covariance);
+}
+
 TEST(GicpMatcher, TheTargetIsReusedNearWhereItWasCut) {
   const GicpParams p = test_params();
   GicpTarget target = target_of(street(0.5, 0.0, 1), p);
