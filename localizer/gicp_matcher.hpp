@@ -59,7 +59,8 @@ struct GicpParams {
   double converged_rotation_rad = 0.001;
   // The local target: map points within max_range_m + target_reuse_m + max_correspondence_widened_m
   // of the prior, kept (with covariances) until the prior moves target_reuse_m from where it was
-  // cut, so covariances are estimated about once a second at 10 m/s, not every scan.
+  // cut, so the target is cut about once a second at 10 m/s, not every scan (and then keeps the
+  // covariances of the points it shares with the last one).
   double target_reuse_m = 10.0;
   // A new target keeps the old one's covariances of the points they share, but for those within this
   // of the old one's edge (their neighbours were cut off there): 2 m, twice the reach of 20 neighbours.
