@@ -5,7 +5,8 @@
 namespace lidarloop {
 
 const std::vector<std::string>& localizer_method_names() {
-  static const std::vector<std::string> names = {"gps", "icp", "icp-obs", "m-icp", "fmt", "intensity", "proposed"};
+  static const std::vector<std::string> names = {"gps", "icp",       "icp-obs",  "m-icp",
+                                                 "fmt", "intensity", "proposed", "gicp"};
   return names;
 }
 

@@ -15,7 +15,9 @@ namespace lidarloop {
 //   fmt        Fourier-Mellin on curb grid images after obstacle removal
 //   intensity  APS on the intensity layer only
 //   proposed   probabilistic ICP after obstacle removal, and APS
-enum class LocalizerMethod { gps, icp, icp_obs, m_icp, fmt, intensity, proposed };
+//   gicp       beyond the paper, a modern dense peer: Generalized-ICP (Open3D) of the whole de-skewed
+//              scan against the map's point-cloud layer, an (x, y, psi) observation; no curbs, no paint
+enum class LocalizerMethod { gps, icp, icp_obs, m_icp, fmt, intensity, proposed, gicp };
 
 // In the enum's order.
 const std::vector<std::string>& localizer_method_names();

@@ -23,7 +23,14 @@ HdMap open_hd_map(const std::string& dir, const std::string& expected_world, siz
   if (std::abs(a.lat_deg - b.lat_deg) > kOriginTolerance || std::abs(a.lon_deg - b.lon_deg) > kOriginTolerance)
     throw InputError(curbs_file + ": origin differs from the intensity layer's (" + header_file +
                      "): the layers are in different local frames");
-  return {std::move(curbs), std::move(intensity)};
+  std::optional<PointMap> points;
+  if (has_point_map(dir)) {
+    points.emplace(dir, max_cached_tiles);
+    if (points->header().world != h.world)
+      throw InputError(dir + "/points.yaml: points of world '" + points->header().world +
+                       "' beside an intensity layer of '" + h.world + "' (" + header_file + ")");
+  }
+  return {std::move(curbs), std::move(intensity), std::move(points)};
 }
 
 }  // namespace lidarloop

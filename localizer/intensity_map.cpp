@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <charconv>
 #include <climits>
 #include <cmath>
 #include <filesystem>
@@ -19,6 +18,7 @@
 #include "common/input_error.hpp"
 #include "common/little_endian.hpp"
 #include "common/yaml_reader.hpp"
+#include "localizer/map_files.hpp"
 
 namespace lidarloop {
 namespace {
@@ -75,19 +75,6 @@ std::string tile_file_name(int tx, int ty) {
   return name;
 }
 
-std::string tile_name(int tx, int ty) {
-  std::string name = "(";
-  name.append(std::to_string(tx)).append(", ").append(std::to_string(ty)).append(")");
-  return name;
-}
-
-// Shortest decimal that reads back to the same double: 0.2 stays "0.2" for people, lat/lon stay exact.
-std::string shortest(double v) {
-  std::array<char, 64> buf{};
-  const auto result = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  return std::string(buf.data(), result.ptr);
-}
-
 void check_geometry(const IntensityMapHeader& h, const char* who) {
   if (!(std::isfinite(h.resolution_m) && h.resolution_m > 0))
     throw std::invalid_argument(std::string(who) + ": resolution_m must be a positive number");
@@ -114,9 +101,6 @@ std::optional<int64_t> global_cell(double coord, double resolution, int tile_cel
   if (cell < lo || cell > hi) return std::nullopt;
   return static_cast<int64_t>(cell);
 }
-
-// Floor division: C++ '/' truncates towards zero, which would fold tiles -1 and 0 together.
-int64_t floor_div(int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
 
 std::optional<CellIndex> try_cell_index(const IntensityMapHeader& h, const Eigen::Vector2d& xy) {
   const auto gx = global_cell(xy.x(), h.resolution_m, h.tile_cells);
@@ -161,20 +145,6 @@ std::string encode_tile(int tx, int ty, int tile_cells, const std::vector<Intens
   return out;
 }
 
-// Writes to a temporary name and renames it over `path`, so a reader never sees half a file.
-void write_file_atomically(const fs::path& path, const std::string& bytes) {
-  const fs::path temp = path.string() + kTempSuffix;
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    out.close();
-    if (!out) throw InputError(temp.string() + ": cannot write file");
-  }
-  std::error_code ec;
-  fs::rename(temp, path, ec);
-  if (ec) throw InputError(path.string() + ": cannot write file: " + ec.message());
-}
-
 // Plain scalars for people; yaml-cpp quotes the ones that would read back as something else ("null", "").
 std::string header_yaml(const IntensityMapHeader& h) {
   YAML::Emitter out;
@@ -184,14 +154,14 @@ std::string header_yaml(const IntensityMapHeader& h) {
   out << YAML::Key << "world" << YAML::Value << h.world;
   out << YAML::Key << "world_hash" << YAML::Value << h.world_hash;
   out << YAML::Key << "origin" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "lat" << YAML::Value << shortest(h.origin.lat_deg);
-  out << YAML::Key << "lon" << YAML::Value << shortest(h.origin.lon_deg);
-  out << YAML::Key << "alt" << YAML::Value << shortest(h.origin.alt_m);
+  out << YAML::Key << "lat" << YAML::Value << shortest_decimal(h.origin.lat_deg);
+  out << YAML::Key << "lon" << YAML::Value << shortest_decimal(h.origin.lon_deg);
+  out << YAML::Key << "alt" << YAML::Value << shortest_decimal(h.origin.alt_m);
   out << YAML::EndMap;
   out << YAML::Key << "projection" << YAML::Value << kProjection;
-  out << YAML::Key << "resolution_m" << YAML::Value << shortest(h.resolution_m);
+  out << YAML::Key << "resolution_m" << YAML::Value << shortest_decimal(h.resolution_m);
   out << YAML::Key << "tile_cells" << YAML::Value << h.tile_cells;
-  out << YAML::Key << "tile_size_m" << YAML::Value << shortest(h.tile_size_m());
+  out << YAML::Key << "tile_size_m" << YAML::Value << shortest_decimal(h.tile_size_m());
   out << YAML::Key << "build" << YAML::Value << YAML::BeginMap;
   for (const auto& [key, value] : h.build) out << YAML::Key << key << YAML::Value << value;
   out << YAML::EndMap;
@@ -450,14 +420,7 @@ IntensityMapHeader read_intensity_map_header(const std::string& dir) {
   YamlMap root(yaml, yaml.root(), "intensity map header");
   IntensityMapHeader h;
 
-  const YAML::Node format = root.required("format");
-  if (yaml.string(format, "format") != kFormatName)
-    yaml.fail(format, "format is '" + format.Scalar() + "', expected '" + kFormatName + "'");
-  const YAML::Node version = root.required("version");
-  const long v = yaml.integer_in(version, "version", LONG_MIN, LONG_MAX);
-  if (v != kFormatVersion)
-    yaml.fail(version,
-              "unsupported version " + std::to_string(v) + " (expected " + std::to_string(kFormatVersion) + ")");
+  read_format_and_version(yaml, root, kFormatName, kFormatVersion);
 
   h.world = yaml.string(root.required("world"), "world");
   h.world_hash = yaml.string(root.required("world_hash"), "world_hash");
@@ -480,7 +443,7 @@ IntensityMapHeader read_intensity_map_header(const std::string& dir) {
   const double size = yaml.number(tile_size, "tile_size_m");
   if (std::fabs(size - h.tile_size_m()) > kTileSizeRelativeTolerance * h.tile_size_m())
     yaml.fail(tile_size, "tile_size_m = " + tile_size.Scalar() +
-                             " does not match resolution_m * tile_cells = " + shortest(h.tile_size_m()));
+                             " does not match resolution_m * tile_cells = " + shortest_decimal(h.tile_size_m()));
 
   const YAML::Node build = root.required("build");
   yaml.expect_map(build, "build");
@@ -489,16 +452,7 @@ IntensityMapHeader read_intensity_map_header(const std::string& dir) {
 
   const YAML::Node tiles = root.required("tiles");
   root.done();
-  yaml.expect_sequence(tiles, "tiles");
-  std::set<std::pair<int, int>> seen;
-  for (const YAML::Node& t : tiles) {
-    if (!t.IsSequence() || t.size() != 2) yaml.fail(t, "a tile must be [ix, iy]");
-    const std::pair<int, int> key{int(yaml.integer_in(t[0], "tile ix", INT_MIN, INT_MAX)),
-                                  int(yaml.integer_in(t[1], "tile iy", INT_MIN, INT_MAX))};
-    if (!seen.insert(key).second) yaml.fail(t, "tile " + tile_name(key.first, key.second) + " is listed twice");
-    h.tiles.push_back(key);
-  }
-  std::sort(h.tiles.begin(), h.tiles.end());
+  h.tiles = read_tile_list(yaml, tiles);
   return h;
 }
 

@@ -155,7 +155,9 @@ std::string describe_health(uint32_t flags) {
                                                                   "curb match rejected",
                                                                   "no intensity match",
                                                                   "intensity match rejected",
-                                                                  "intensity match ambiguous"};
+                                                                  "intensity match ambiguous",
+                                                                  "no point match",
+                                                                  "point match rejected"};
   if (flags == 0) return "ok";
   std::string out;
   for (int i = 0; i < kHealthFlagCount; ++i)
@@ -165,8 +167,8 @@ std::string describe_health(uint32_t flags) {
 
 const char* stage_name(Stage s) {
   static const std::array<const char*, kStageCount> names = {
-      "deskew",        "corridor",      "obstacles",          "curb_detection",
-      "curb_features", "curb_matching", "intensity_matching", "fusion"};
+      "deskew",        "corridor",           "obstacles",      "curb_detection", "curb_features",
+      "curb_matching", "intensity_matching", "point_matching", "fusion"};
   return names[size_t(s)];
 }
 
@@ -297,6 +299,12 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
     return;
   }
 
+  if (method == LocalizerMethod::gicp) {
+    if (const std::optional<PoseObservation> z = match_points(points, e))
+      if (!fuse_pose(*z, point_rejections_, e)) e.health |= kPointMatchRejected;
+    return;
+  }
+
   std::vector<size_t> ground;  // the road surface, indices into points
   std::optional<Plane> plane;
   if (removes_obstacles(method)) {
@@ -317,7 +325,7 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
     S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, intensity_calibration_, e);
 
   if (uses_curbs(method)) {
-    const std::optional<CurbObservation> z = match_curbs(features_.curbs, e);  // 3.1
+    const std::optional<PoseObservation> z = match_curbs(features_.curbs, e);  // 3.1
     if (z) fuse_curbs(*z, e);                                                  // 3.3
   }
   if (S) {
@@ -393,7 +401,7 @@ std::vector<Eigen::Vector2d> Localizer::curb_features(std::vector<Eigen::Vector2
 
 // 3.1: the pose the curb features put the car at, matched against the map's curbs around the prior,
 // with the covariance the match supports; nullopt (and why, in e.health) if there is none to use.
-std::optional<Localizer::CurbObservation> Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features,
+std::optional<Localizer::PoseObservation> Localizer::match_curbs(const std::vector<Eigen::Vector2d>& features,
                                                                  LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::curb_matching));
   if (features.size() < size_t(params_.health.min_curbs)) {
@@ -419,7 +427,7 @@ std::optional<Localizer::CurbObservation> Localizer::match_curbs(const std::vect
     e.health |= kCurbMatchRejected;
     return std::nullopt;
   }
-  return CurbObservation{z, q.covariance};
+  return PoseObservation{z, q.covariance};
 }
 
 // The correction of the prior that the method's matcher finds (a transform of the local frame):
@@ -454,22 +462,69 @@ std::optional<Pose2d> Localizer::curb_correction(const std::vector<Eigen::Vector
     }
     case LocalizerMethod::gps:
     case LocalizerMethod::intensity:
+    case LocalizerMethod::gicp:
       break;  // no curb matcher: process_scan does not ask
   }
   return std::nullopt;
 }
 
 // 3.3: the curb observation (x, y, psi) into KF2, if it passes the innovation gate.
-void Localizer::fuse_curbs(const CurbObservation& z, LocalizerEstimate& e) {
+void Localizer::fuse_curbs(const PoseObservation& z, LocalizerEstimate& e) {
+  if (!fuse_pose(z, curb_rejections_, e)) e.health |= kCurbMatchRejected;
+}
+
+bool Localizer::fuse_pose(const PoseObservation& z, int& rejections, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::fusion));
   const Pose2d prior = filter_->pose();
   const Eigen::Vector3d innovation(z.pose.x - prior.x, z.pose.y - prior.y, wrap_angle(z.pose.yaw - prior.yaw));
   const Eigen::Matrix3d S = filter_->covariance() + z.covariance;
-  if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_curb, curb_rejections_)) {
-    e.health |= kCurbMatchRejected;
-    return;
-  }
+  if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_curb, rejections)) return false;
   filter_->update_curb(Eigen::Vector3d(z.pose.x, z.pose.y, z.pose.yaw), z.covariance);  // KF2
+  return true;
+}
+
+// gicp: the pose Generalized-ICP of the scan against the map's points around the prior puts the car at,
+// with its covariance; nullopt (and why, in e.health) if there is none to use. The target is cut anew
+// only when the car has left the part of the map the last one was cut for.
+std::optional<Localizer::PoseObservation> Localizer::match_points(const ScanPoints& points, LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::point_matching));
+  const GicpParams& g = params_.gicp;
+  const Pose2d prior = filter_->pose();
+  if (!map_.points) {
+    e.health |= kNoPointMatch;
+    return std::nullopt;
+  }
+  if (!gicp_target_.covers(xy(prior), g))
+    gicp_target_.build(map_.points->points_near(xy(prior), GicpTarget::radius(g)), xy(prior), g);
+  // Correspondences as far as the prior is uncertain, as for the curbs (icp_window_sigmas).
+  const double sigma = std::sqrt(filter_->covariance().topLeftCorner<2, 2>().eigenvalues().real().maxCoeff());
+  const double max_correspondence =
+      std::max(g.max_correspondence_m, std::min(g.window_sigmas * sigma, g.max_correspondence_widened_m));
+  // The filter's x, y, psi; height, roll and pitch from the last registration (the road's, nearby).
+  // (Z-Y-X angles read directly: small pitch and roll never flip as Eigen's eulerAngles may.)
+  const Eigen::Matrix3d& last = last_registration_.linear();
+  const double pitch = std::asin(std::clamp(-last(2, 0), -1.0, 1.0)), roll = std::atan2(last(2, 1), last(2, 2));
+  Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+  start.linear() =
+      (Eigen::AngleAxisd(prior.yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  start.translation() = Eigen::Vector3d(prior.x, prior.y, last_registration_.translation().z());
+  const GicpResult r = gicp_match(points.xyz, start, gicp_target_, g, max_correspondence);
+  e.point_fitness = r.fitness;
+  if (r.status == GicpStatus::few_map_points || r.status == GicpStatus::few_scan_points) {
+    e.health |= kNoPointMatch;
+    return std::nullopt;
+  }
+  const Eigen::Matrix3d R = r.pose.linear();
+  const Pose2d z{r.pose.translation().x(), r.pose.translation().y(), wrap_angle(std::atan2(R(1, 0), R(0, 0)))};
+  e.point_observation = z;
+  if (!r.ok()) {
+    e.health |= kPointMatchRejected;
+    return std::nullopt;
+  }
+  last_registration_ = r.pose;
+  return PoseObservation{z, r.covariance};
 }
 
 // 3.2: APS of S against the intensity layer (Eq. 14-18) around the pose after the curb update; nullopt

@@ -10,7 +10,9 @@
 //   (Eq. 6-7) (2.2.1) -> grid S of the ground's intensities (2.2.2, Eq. 8) -> probabilistic ICP
 //   against the map (3.1) -> KF2 curb update (x, y, psi) (3.3) -> APS of S against the intensity
 //   layer around the updated pose (3.2) -> KF2 intensity update (x, y) (3.3).
-// GPS fixes update KF1 as they come. The baselines swap or drop the matching steps (LocalizerMethod).
+// GPS fixes update KF1 as they come. The baselines swap or drop the matching steps (LocalizerMethod);
+// `gicp` replaces them all by Generalized-ICP of the de-skewed scan against the map's point-cloud layer
+// (gicp_matcher.hpp), fused as the curb observation is (KF2 x, y, psi, the same chi^2 gate).
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -25,6 +27,7 @@
 #include "common/vehicle_messages.hpp"
 #include "localizer/curb_features.hpp"
 #include "localizer/deskew.hpp"
+#include "localizer/gicp_matcher.hpp"
 #include "localizer/hd_map.hpp"
 #include "localizer/intensity_calibration.hpp"
 #include "localizer/localizer_params.hpp"
@@ -45,8 +48,10 @@ enum HealthFlag : uint32_t {
   kNoIntensityMatch = 1u << 9,   // APS had too few usable cells (off the intensity map, road hidden)
   kIntensityMatchRejected = 1u << 10,
   kIntensityAmbiguous = 1u << 11,  // APS's distribution was as wide as its window on every axis it may update
+  kNoPointMatch = 1u << 12,        // gicp: no point-cloud layer, too few map or scan points to register
+  kPointMatchRejected = 1u << 13,  // gicp: not converged, too few scan points matched, or the gate refused it
 };
-constexpr int kHealthFlagCount = 12;
+constexpr int kHealthFlagCount = 14;
 // "ok", or the set flags as words: "no GPS, few curbs".
 std::string describe_health(uint32_t flags);
 
@@ -59,9 +64,10 @@ enum class Stage {
   curb_features,
   curb_matching,
   intensity_matching,
+  point_matching,  // gicp: the local target (when it is cut anew) and the registration
   fusion
 };
-constexpr int kStageCount = 8;
+constexpr int kStageCount = 9;
 const char* stage_name(Stage s);
 
 struct LocalizerEstimate {
@@ -77,6 +83,8 @@ struct LocalizerEstimate {
   double curb_inlier_ratio = 0;
   std::optional<Eigen::Vector2d> intensity_observation;
   int intensity_cells = 0;
+  std::optional<Pose2d> point_observation;  // gicp: where the registration put the car (even if refused)
+  double point_fitness = 0;                 // gicp: fraction of the downsampled scan's points matched
   std::array<double, kStageCount> stage_ms{};
   double total_ms = 0;
 
@@ -114,8 +122,9 @@ class Localizer {
   const ScanFeatures& last_features() const { return features_; }
 
  private:
-  // The curb observation of KF2: the pose the curbs put the car at, and how well they pin it down.
-  struct CurbObservation {
+  // A pose observation of KF2 (curbs, or gicp's registration): the pose it puts the car at, and how well
+  // it pins it down.
+  struct PoseObservation {
     Pose2d pose;
     Eigen::Matrix3d covariance;
   };
@@ -129,10 +138,13 @@ class Localizer {
   std::vector<Eigen::Vector2d> curb_features(std::vector<Eigen::Vector2d> curbs,
                                              const std::vector<Eigen::Vector2d>& obstacles, const Pose2d& motion,
                                              LocalizerEstimate& e);
-  std::optional<CurbObservation> match_curbs(const std::vector<Eigen::Vector2d>& features, LocalizerEstimate& e);
+  std::optional<PoseObservation> match_curbs(const std::vector<Eigen::Vector2d>& features, LocalizerEstimate& e);
   std::optional<Pose2d> curb_correction(const std::vector<Eigen::Vector2d>& features_world, const MapIndex& local_map,
                                         const Pose2d& prior);
-  void fuse_curbs(const CurbObservation& z, LocalizerEstimate& e);
+  void fuse_curbs(const PoseObservation& z, LocalizerEstimate& e);
+  // The KF2 update (x, y, psi) behind the chi^2 gate; false if the gate refused it.
+  bool fuse_pose(const PoseObservation& z, int& rejections, LocalizerEstimate& e);
+  std::optional<PoseObservation> match_points(const ScanPoints& points, LocalizerEstimate& e);
   std::optional<ApsResult> match_intensity(IntensityGrid& S, LocalizerEstimate& e);
   ApsParams aps_window(const Pose2d& prior) const;
   void fuse_intensity(const ApsResult& aps, LocalizerEstimate& e);
@@ -158,7 +170,11 @@ class Localizer {
 
   CurbAccumulator accumulator_;
   std::optional<Pose2d> previous_scan_odometry_;
-  int curb_rejections_ = 0, intensity_rejections_ = 0;
+  int curb_rejections_ = 0, intensity_rejections_ = 0, point_rejections_ = 0;
+  GicpTarget gicp_target_;
+  // The last registration's height, roll and pitch: the next one's starting guess (the filter has only
+  // x, y, psi).
+  Eigen::Isometry3d last_registration_ = Eigen::Isometry3d::Identity();
   IntensityCalibration intensity_calibration_;
   ScanFeatures features_;
 };

@@ -21,7 +21,10 @@ bool uses_curbs(LocalizerMethod m) {
          m == LocalizerMethod::fmt || m == LocalizerMethod::proposed;
 }
 bool uses_intensity(LocalizerMethod m) { return m == LocalizerMethod::intensity || m == LocalizerMethod::proposed; }
-bool removes_obstacles(LocalizerMethod m) { return m != LocalizerMethod::icp && m != LocalizerMethod::gps; }
+// gicp registers the whole scan: what moves finds no partner in the map and drops out of its fitness.
+bool removes_obstacles(LocalizerMethod m) {
+  return m != LocalizerMethod::icp && m != LocalizerMethod::gps && m != LocalizerMethod::gicp;
+}
 
 std::vector<std::string> split_command_line(const std::string& text) {
   std::vector<std::string> words;
@@ -181,6 +184,28 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("max_radius_fraction", p.fmt.max_radius_fraction, 0.0, 1.0)
       .integer("min_points", p.fmt.min_points, 1, 100000)
       .number("min_response", p.fmt.min_response, 0.0, 1.0)
+      .done();
+  YamlMap(y, top["gicp"], "gicp")
+      .number("scan_voxel_m", p.gicp.scan_voxel_m, 0.05, 10.0)
+      .number("max_range_m", p.gicp.max_range_m, 1.0, 200.0)
+      .number("min_height_m", p.gicp.min_height_m, -100.0, 0.0)
+      .integer("covariance_neighbours", p.gicp.covariance_neighbours, 3, 1000)
+      .number("epsilon", p.gicp.epsilon, 1e-9, 1.0)
+      .number("max_correspondence_m", p.gicp.max_correspondence_m, 0.01, 100.0)
+      .number("window_sigmas", p.gicp.window_sigmas, 0.0, 100.0)
+      .number("max_correspondence_widened_m", p.gicp.max_correspondence_widened_m, 0.01, 100.0)
+      .number("relative_fitness", p.gicp.relative_fitness, 0.0, 1.0)
+      .number("relative_rmse", p.gicp.relative_rmse, 0.0, 1.0)
+      .integer("max_iterations", p.gicp.max_iterations, 1, 1000)
+      .number("converged_translation_m", p.gicp.converged_translation_m, 0.0, 100.0)
+      .number("converged_rotation_rad", p.gicp.converged_rotation_rad, 0.0, 3.2)
+      .number("target_reuse_m", p.gicp.target_reuse_m, 0.0, 1000.0)
+      .number("covariance_reuse_margin_m", p.gicp.covariance_reuse_margin_m, 0.0, 1000.0)
+      .integer("min_scan_points", p.gicp.min_scan_points, 0, 10000000)
+      .integer("min_map_points", p.gicp.min_map_points, 0, 100000000)
+      .number("min_fitness", p.gicp.min_fitness, 0.0, 1.0)
+      .number("map_sigma_m", p.gicp.map_sigma_m, 0.0, 100.0)
+      .number("map_sigma_yaw_rad", p.gicp.map_sigma_yaw_rad, 0.0, 3.2)
       .done();
   YamlMap(y, top["intensity_grid"], "intensity_grid")
       .integer("width_cells", p.intensity_grid.width_cells, 10, 4000)

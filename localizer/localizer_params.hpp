@@ -16,6 +16,7 @@
 #include "localizer/curb_match_covariance.hpp"
 #include "localizer/driving_corridor.hpp"
 #include "localizer/fmt_matcher.hpp"
+#include "localizer/gicp_matcher.hpp"
 #include "localizer/intensity_calibration.hpp"
 #include "localizer/obstacle_rejection.hpp"
 #include "localizer/pose_filter.hpp"
@@ -88,6 +89,7 @@ struct LocalizerParams {
   IcpParams icp;  // the icp and icp-obs baselines
   MIcpParams m_icp;
   FmtParams fmt;
+  GicpParams gicp;  // the gicp method (beyond the paper): see gicp_matcher.hpp
   IntensityGridParams intensity_grid;
   IntensityCalibrationParams intensity_calibration;  // beyond the paper: see intensity_calibration.hpp
   ApsParams aps;

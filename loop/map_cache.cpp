@@ -31,8 +31,9 @@ constexpr uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3
 // are driven in parts of 16 scans, each accumulated on its own and merged into the map with Chan's
 // formula in a fixed order (place, then lane), where one Welford stream ran lane after lane: the same
 // points per cell, means and variances that may differ in the last bit of the stored float (large: 44
-// of its cells' m2 by one ulp; campus: none).
-constexpr int kMapFormatVersion = 4;
+// of its cells' m2 by one ulp; campus: none). 5: the point-cloud layer (points.yaml, points/) for the
+// gicp method.
+constexpr int kMapFormatVersion = 5;
 
 static void hash_bytes(uint64_t& h, const std::string& bytes) {
   for (unsigned char c : bytes) h = (h ^ c) * kFnvPrime;
@@ -158,6 +159,7 @@ MapLocation ensure_map(const std::string& world_name, const MappingOptions& opti
   const std::string tmp = make_build_dir(loc.dir);
   // Tiles are written as the drive finishes them: memory holds the open ones, not the map.
   IntensityMapWriter writer(tmp);
+  PointMapWriter points(tmp);
   const IntensityMapHeader header = run_mapping_drive(
       w.description, w.world, w.materials, actors_dir(), options, loc.hash,
       [&](const IntensityMapHeader& h, const std::pair<int, int>& key, std::vector<IntensityMoments>& cells) {
@@ -167,7 +169,8 @@ MapLocation ensure_map(const std::string& world_name, const MappingOptions& opti
         if (!terminal) return;
         std::printf("\rmapping %s %3d%%", w.world.name.c_str(), int(f * 100));
         std::fflush(stdout);
-      });
+      },
+      &points);
   if (terminal) std::printf("\r%40s\r", "");
   writer.finish(header);
   // The curbs and the pictures are independent files: made side by side.

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
@@ -34,7 +36,8 @@ std::string MappingOptions::describe() const {
   std::ostringstream s;
   s << "traffic=" << traffic << " speed=" << speed << " resolution=" << resolution << " tile_cells=" << tile_cells
     << " max_ground_height=" << max_ground_height << " max_range=" << max_range << " seed=" << seed
-    << " survey_unit_serial=" << survey_unit_serial << " " << survey_error.describe();
+    << " survey_unit_serial=" << survey_unit_serial << " " << survey_error.describe()
+    << " point_voxel=" << point_voxel_m << " point_scan_stride=" << point_scan_stride;
   if (ideal_ground) s << " ideal_ground=1";  // absent when off, so typical maps keep their cache key
   return s.str();
 }
@@ -195,11 +198,36 @@ std::vector<DrivePart> plan_parts(const IntensityMapHeader& header, const Survey
   return parts;
 }
 
-// One part of a lane, driven into a builder of its own (small tiles, made where points fall).
-IntensityMapBuilder drive_part(const DriveSetup& d, const IntensityMapHeader& header, const DrivePart& part) {
+// What a part of the drive adds to the map: intensities, and points if the point layer is made.
+struct PartMaps {
+  IntensityMapBuilder intensity;
+  std::optional<PointMapBuilder> points;
+};
+
+// The point layer's header: its tiles are the intensity layer's, in whole voxels.
+PointMapHeader point_map_header(const IntensityMapHeader& intensity, double voxel_m) {
+  constexpr double kWholeVoxels = 1e-9;  // relative
+  PointMapHeader h;
+  h.world = intensity.world;
+  h.world_hash = intensity.world_hash;
+  h.voxel_m = voxel_m;
+  const double voxels = intensity.tile_size_m() / voxel_m;
+  h.tile_voxels = int(std::lround(voxels));
+  if (h.tile_voxels < 1 || std::abs(voxels - h.tile_voxels) > kWholeVoxels * voxels)
+    throw std::invalid_argument("mapping: the point voxel (" + std::to_string(voxel_m) +
+                                " m) must divide the intensity tiles (" + std::to_string(intensity.tile_size_m()) +
+                                " m)");
+  return h;
+}
+
+// One part of a lane, driven into builders of its own (small tiles, made where points fall).
+PartMaps drive_part(const DriveSetup& d, const IntensityMapHeader& header, const std::optional<PointMapHeader>& points,
+                    const DrivePart& part) {
   IntensityMapHeader part_header = header;
   part_header.tile_cells = kPartTileCells;
-  IntensityMapBuilder builder(part_header);
+  PartMaps maps{IntensityMapBuilder(part_header), {}};
+  IntensityMapBuilder& builder = maps.intensity;
+  if (points) maps.points.emplace(*points);
   const SurveyLane& lane = d.survey.lanes[part.lane];
   const Path& path = lane.path;
   const MappingOptions& o = d.o;
@@ -259,27 +287,31 @@ IntensityMapBuilder drive_part(const DriveSetup& d, const IntensityMapHeader& he
     const PointCloud cloud = d.scanner.scan(scene, vehicle, stamp, o.seed, actor_poses);
     // The survey places each point with its pose at the point's own firing cycle.
     uint32_t cycle = UINT32_MAX;
+    PointMapBuilder* const point_layer = maps.points && k % o.point_scan_stride == 0 ? &*maps.points : nullptr;
     Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
     for (const LidarPoint& p : cloud.points) {
       if (double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z > o.max_range * o.max_range) continue;
-      if (p.intensity > 100) continue;  // a sign or a reflector, not the road surface
+      if (p.intensity > 100 && !point_layer) continue;  // a sign or a reflector, not the road surface
       const uint32_t c = uint32_t(p.t_ns / cycle_ns);
       if (c != cycle) cycle = c, body = surveyed(stamp + int64_t(c) * cycle_ns);
+      const Eigen::Vector3d w = body * (mount * Eigen::Vector3d(p.x, p.y, p.z));
+      if (point_layer) point_layer->add(w);  // every surface: the point layer
+      if (p.intensity > 100) continue;
       // Higher than this above the ground under the car, a point cannot be ground. Level, not in the
       // plane of the wheels: on a 2 % crown that plane is 0.4 m off at 20 m across the road.
-      const Eigen::Vector3d w = body * (mount * Eigen::Vector3d(p.x, p.y, p.z));
       if (w.z() - body.translation().z() > o.max_ground_height) continue;
       builder.add(w.head<2>(), p.intensity);
     }
   }
-  return builder;
+  return maps;
 }
 
 // The drive itself: the map's tiles are handed to `finished` as they are finished, if it is given, or
 // kept in the builder returned.
 IntensityMapBuilder drive(const WorldDescription& description, const World& world, const MaterialTable& materials,
                           const std::string& actors_dir, const MappingOptions& o, const std::string& world_hash,
-                          const FinishedTile* finished, const std::function<void(double)>& progress) {
+                          const FinishedTile* finished, const std::function<void(double)>& progress,
+                          PointMapWriter* point_writer) {
   IntensityMapHeader header;
   header.world = description.name;
   header.world_hash = world_hash;
@@ -288,6 +320,9 @@ IntensityMapBuilder drive(const WorldDescription& description, const World& worl
   header.resolution_m = o.resolution;
   header.tile_cells = o.tile_cells;
   IntensityMapBuilder map(header);
+  std::optional<PointMapHeader> point_header;
+  std::optional<PointMapBuilder> points;
+  if (point_writer) point_header = point_map_header(header, o.point_voxel_m), points.emplace(*point_header);
 
   // The survey unit, of its own serial, calibrated in situ by the surveyors (no range biases or
   // intensity offsets left, no mixed returns or dropouts modelled), on a dry day: the map is the same
@@ -314,11 +349,14 @@ IntensityMapBuilder drive(const WorldDescription& description, const World& worl
     if (!finished) return;
     std::vector<IntensityMoments> cells = map.take_tile(key);
     if (!cells.empty()) (*finished)(map.header(), key, cells);
+    if (!points) return;
+    const std::vector<Eigen::Vector3f> tile = points->take_tile(key);
+    if (!tile.empty()) point_writer->write_tile(key, tile);
   };
 
   struct Driven {
     size_t part = 0;
-    std::shared_ptr<const IntensityMapBuilder> map;
+    std::shared_ptr<const PartMaps> maps;
   };
   size_t next = 0;
   tbb::parallel_pipeline(
@@ -327,9 +365,10 @@ IntensityMapBuilder drive(const WorldDescription& description, const World& worl
         if (next == parts.size()) fc.stop();
         return next++;
       }) & tbb::make_filter<size_t, Driven>(tbb::filter_mode::parallel, [&](size_t i) {
-        return Driven{i, std::make_shared<const IntensityMapBuilder>(drive_part(setup, header, parts[i]))};
+        return Driven{i, std::make_shared<const PartMaps>(drive_part(setup, header, point_header, parts[i]))};
       }) & tbb::make_filter<Driven, void>(tbb::filter_mode::serial_in_order, [&](const Driven& d) {
-        map.merge(*d.map);
+        map.merge(d.maps->intensity);
+        if (points) points->merge(*d.maps->points);
         const DrivePart& part = parts[d.part];
         for (const auto& key : part.tiles)
           if (last_part.at(key) == d.part) hand_over(key);
@@ -339,6 +378,13 @@ IntensityMapBuilder drive(const WorldDescription& description, const World& worl
   // Tiles no part was expected to reach (none, if the reach above is right) go last, in key order.
   for (const auto& key : std::vector<std::pair<int, int>>(map.header().tiles))
     if (!last_part.count(key)) hand_over(key);
+  if (points) {
+    for (const auto& key : std::vector<std::pair<int, int>>(points->header().tiles))
+      if (!last_part.count(key))
+        if (const std::vector<Eigen::Vector3f> tile = points->take_tile(key); !tile.empty())
+          point_writer->write_tile(key, tile);
+    point_writer->finish(points->header());
+  }
   return map;
 }
 
@@ -347,15 +393,16 @@ IntensityMapBuilder drive(const WorldDescription& description, const World& worl
 IntensityMapHeader run_mapping_drive(const WorldDescription& description, const World& world,
                                      const MaterialTable& materials, const std::string& actors_dir,
                                      const MappingOptions& o, const std::string& world_hash,
-                                     const FinishedTile& finished, const std::function<void(double)>& progress) {
-  return drive(description, world, materials, actors_dir, o, world_hash, &finished, progress).header();
+                                     const FinishedTile& finished, const std::function<void(double)>& progress,
+                                     PointMapWriter* points) {
+  return drive(description, world, materials, actors_dir, o, world_hash, &finished, progress, points).header();
 }
 
 IntensityMapBuilder run_mapping_drive(const WorldDescription& description, const World& world,
                                       const MaterialTable& materials, const std::string& actors_dir,
                                       const MappingOptions& o, const std::string& world_hash,
                                       const std::function<void(double)>& progress) {
-  return drive(description, world, materials, actors_dir, o, world_hash, nullptr, progress);
+  return drive(description, world, materials, actors_dir, o, world_hash, nullptr, progress, nullptr);
 }
 
 }  // namespace lidarloop

@@ -3,13 +3,16 @@
 // two-way roads) and accumulates the intensities of ground returns into the intensity layer, as a
 // survey vehicle does before a localizer can run. The map is a survey, not the world: each scan is
 // placed with the pose the survey car's RTK-INS reports (the truth plus loop/survey_error.hpp's error),
-// and the survey car's HDL-32E is another unit than the test car's, with its own per-laser gains.
+// and the survey car's HDL-32E is another unit than the test car's, with its own per-laser gains. The
+// same drive, if asked, builds the point-cloud layer (localizer/point_map.hpp): every return within
+// max_range, placed with the survey pose of its own firing (de-skewed), one centroid per voxel.
 #include <functional>
 #include <random>
 #include <string>
 
 #include "common/yaml_reader.hpp"
 #include "localizer/intensity_map.hpp"
+#include "localizer/point_map.hpp"
 #include "loop/survey_map.hpp"
 #include "sim/materials.hpp"
 #include "sim/realism.hpp"
@@ -35,6 +38,15 @@ struct MappingOptions {
   // Map the world on ideal ground (flat roads, ideal curbs: on_ideal_ground), as the `ideal` profile's
   // car drives it.
   bool ideal_ground = false;
+  // The point-cloud layer's voxel, m: one point (the centroid) per voxel. 0.4 m keeps the surfaces a
+  // GICP needs (curb faces, walls, poles of 0.1-0.3 m are one voxel thick) at about a quarter of the
+  // points of 0.2 m, and divides the intensity tiles' 64 m into whole voxels (160), so both layers
+  // share one tile grid. GICP's own scan voxel is coarser still (GicpParams::scan_voxel_m).
+  double point_voxel_m = 0.4;
+  // Every this many survey scans feed the point layer: 4 is 6 m apart at 15 m/s, so a surface within
+  // the 40 m range is still seen from a dozen places, while the layer costs a quarter of the time
+  // (each return is a hash-table update; the intensity layer takes every scan).
+  int point_scan_stride = 4;
 
   std::string describe() const;  // every option as text, for the cache key and the map header
 };
@@ -79,6 +91,8 @@ IntensityMapHeader run_mapping_drive(const WorldDescription& description, const 
                                      const MaterialTable& materials, const std::string& actors_dir,
                                      const MappingOptions& options, const std::string& world_hash,
                                      const FinishedTile& finished,
-                                     const std::function<void(double fraction)>& progress = {});
+                                     const std::function<void(double fraction)>& progress = {},
+                                     PointMapWriter* points = nullptr);
+// `points`, if given, receives the point-cloud layer tile by tile, finished with its header.
 
 }  // namespace lidarloop

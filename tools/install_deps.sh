@@ -9,6 +9,7 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libpolyclipping-dev nlohmann-json3-dev libzstd-dev
+  libopen3d-dev
 )
 
 missing=()
