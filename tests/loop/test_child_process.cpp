@@ -55,7 +55,7 @@ TEST(ChildProcess, AProgramThatExitsEndsItsOutput) {
 TEST(ChildProcess, WritingToAProgramThatStoppedReadingIsReportedNotFatal) {
   // Without care, the write would raise SIGPIPE and kill the test process.
   ChildProcess child({"sh", "-c", "exec 0<&-; sleep 30"});
-  child.send(std::vector<uint8_t>(1 << 20, 'x'));
+  child.send(std::vector<uint8_t>(8 << 20, 'x'));  // more than the pipe holds, whenever it closes stdin
   std::string line;
   EXPECT_EQ(child.read_line(Clock::now() + 5s, line), ChildProcess::LineStatus::stdin_closed);
 }
