@@ -33,13 +33,6 @@ Eigen::Vector2d xy(const Pose2d& p) { return {p.x, p.y}; }
 
 double& stage_ms(LocalizerEstimate& e, Stage s) { return e.stage_ms[size_t(s)]; }
 
-// The scan's last firing, after its stamp: the time the scan's pose is reported for.
-int64_t scan_duration_ns(const PointCloud& cloud) {
-  uint32_t last_t = 0;
-  for (const LidarPoint& p : cloud.points) last_t = std::max(last_t, p.t_ns);
-  return int64_t(last_t);
-}
-
 // The scan in the vehicle frame at `reference_ns` after its stamp, de-skewed with CAN's motion over
 // the scan unless that is switched off.
 ScanPoints vehicle_frame_points(const PointCloud& cloud, const LocalizerParams& params, const ScanMotion& motion,

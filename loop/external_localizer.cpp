@@ -37,13 +37,7 @@ std::string quoted_excerpt(const std::string& text) {
   return "'" + shown + (text.size() > kShown ? "...'" : "'");
 }
 
-// The scan's last firing: the time the built-in localizers report a scan's pose for, and the default
-// stamp of an answer.
-int64_t scan_end_ns(const PointCloud& cloud) {
-  uint32_t last = 0;
-  for (const LidarPoint& p : cloud.points) last = std::max(last, p.t_ns);
-  return cloud.stamp_ns + int64_t(last);
-}
+int64_t scan_end_ns(const PointCloud& cloud) { return cloud.stamp_ns + scan_duration_ns(cloud); }
 
 double finite_number(const nlohmann::json& answer, const char* key, const std::string& where) {
   const auto& v = answer.at(key);

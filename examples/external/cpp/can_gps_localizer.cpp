@@ -122,12 +122,6 @@ class CanGpsFilter {
   double speed_ = 0, steer_ = 0;
 };
 
-int64_t scan_end_ns(const PointCloud& cloud) {
-  uint32_t last = 0;
-  for (const LidarPoint& p : cloud.points) last = std::max(last, p.t_ns);
-  return cloud.stamp_ns + int64_t(last);
-}
-
 void answer(int scan, const CanGpsFilter& filter, int64_t stamp_ns) {
   if (!filter.initialized()) {
     std::printf("{\"scan\": %d}\n", scan);
@@ -179,7 +173,8 @@ int main() {
       } else if (topic == log_topics::vehicle_report) {
         filter->on_can(ros2::decode_vehicle_report(m.data, topic));
       } else if (topic == log_topics::scan) {
-        const int64_t t = scan_end_ns(ros2::decode_point_cloud(m.data, topic));
+        const PointCloud cloud = ros2::decode_point_cloud(m.data, topic);
+        const int64_t t = cloud.stamp_ns + scan_duration_ns(cloud);
         filter->predict_to(t);
         answer(scans++, *filter, t);
       }
