@@ -1,0 +1,323 @@
+#include "loop/lanelet2_map.hpp"
+
+#include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include <osmium/builder/attr.hpp>
+#include <osmium/io/header.hpp>
+#include <osmium/io/writer.hpp>
+#include <osmium/io/xml_output.hpp>
+#include <osmium/memory/buffer.hpp>
+
+#include "common/input_error.hpp"
+#include "localizer/map_files.hpp"
+#include "sim/path.hpp"
+#include "sim/polyline.hpp"
+
+namespace lidarloop {
+
+namespace {
+
+namespace attr = osmium::builder::attr;
+using Tags = std::vector<std::pair<std::string, std::string>>;
+using Member = attr::member_type;
+
+// Autoware's crosswalk module stops this far before a crosswalk that has no stop line
+// (autoware_behavior_velocity_crosswalk_module, crosswalk.param.yaml: stop_distance_from_crosswalk 3.5 m):
+// a derived stop line goes where Autoware would stop anyway.
+constexpr double kDerivedStopDistance = 3.5;
+// A stop line of the world at most this far before a crosswalk's near edge is that crosswalk's: the
+// campus paints them 4 m before; farther ones serve a junction.
+constexpr double kCrosswalkStopLineReach = 10.0;
+constexpr size_t kInitialBufferBytes = size_t(1) << 20;  // libosmium buffers grow from here
+
+// One OSM document under construction. Lanelet2 keeps points, line strings and relations in one id
+// space (lanelet2_core: utils::getId() draws every primitive's id from one counter), so every object
+// takes the next id; nodes at the same place are one node, so bounds that meet share their ends, which
+// is how Lanelet2's routing finds a lane's successor (lanelet2_routing: "follows" compares end points).
+class OsmDocument {
+ public:
+  OsmDocument(const Geodetic& origin, GroundHeight height) : frame_(origin), height_(std::move(height)) {}
+
+  int64_t way(const Polyline2d& line, const Tags& tags) {
+    std::vector<osmium::object_id_type> refs;
+    for (const Eigen::Vector2d& p : line)
+      if (const int64_t id = node(p); refs.empty() || refs.back() != id) refs.push_back(id);
+    const int64_t id = next_id_++;
+    osmium::builder::add_way(ways_, attr::_id(id), attr::_version(1), attr::_nodes(refs), attr::_tags(tags));
+    return id;
+  }
+
+  int64_t relation(const std::vector<Member>& members, const Tags& tags) {
+    const int64_t id = next_id_++;
+    osmium::builder::add_relation(relations_, attr::_id(id), attr::_version(1), attr::_members(members),
+                                  attr::_tags(tags));
+    return id;
+  }
+
+  size_t nodes() const { return node_ids_.size(); }
+
+  void write(const std::string& path) {
+    osmium::io::Header header;
+    header.set("generator", "lidarloop");
+    try {
+      osmium::io::Writer writer(osmium::io::File(path, "osm"), header, osmium::io::overwrite::allow);
+      // Nodes, then ways, then relations: the order of an OSM file (JOSM reads no other).
+      writer(std::move(nodes_));
+      writer(std::move(ways_));
+      writer(std::move(relations_));
+      writer.close();
+    } catch (const std::exception& e) {
+      throw InputError(path + ": cannot write the Lanelet2 map (" + e.what() + ")");
+    }
+  }
+
+ private:
+  int64_t node(const Eigen::Vector2d& p) {
+    const auto [it, added] = node_ids_.try_emplace({p.x(), p.y()}, next_id_);
+    if (!added) return it->second;
+    const Geodetic g = frame_.to_geodetic(p);
+    // local_x/local_y: Autoware's "Local Coordinate Expression" (lanelet2_format_extension.md), what its
+    // map loader uses with projector_type Local; ele on every node is mandatory for Autoware (same file,
+    // "Elevation Tags").
+    const Tags tags = {{"local_x", shortest_decimal(p.x())},
+                       {"local_y", shortest_decimal(p.y())},
+                       {"ele", shortest_decimal(height_(p))}};
+    osmium::builder::add_node(nodes_, attr::_id(next_id_), attr::_version(1),
+                              attr::_location(osmium::Location(g.lon_deg, g.lat_deg)), attr::_tags(tags));
+    return next_id_++;
+  }
+
+  LocalFrame frame_;
+  GroundHeight height_;
+  int64_t next_id_ = 1;
+  std::map<std::pair<double, double>, int64_t> node_ids_;
+  osmium::memory::Buffer nodes_{kInitialBufferBytes, osmium::memory::Buffer::auto_grow::yes};
+  osmium::memory::Buffer ways_{kInitialBufferBytes, osmium::memory::Buffer::auto_grow::yes};
+  osmium::memory::Buffer relations_{kInitialBufferBytes, osmium::memory::Buffer::auto_grow::yes};
+};
+
+// Lanelet2 LinestringTagging.md: a lane marking is line_thin with its style as subtype (dashed allows
+// a lane change, solid does not); no marking is a virtual line; the end of the carriageway road_border.
+Tags divider_tags(MarkingStyle style) {
+  if (style == MarkingStyle::none) return {{"type", "virtual"}};
+  return {{"type", "line_thin"}, {"subtype", style == MarkingStyle::dashed ? "dashed" : "solid"}};
+}
+
+// A stretch of a road between two centreline vertices: lanelets are cut where the road is.
+struct Piece {
+  size_t first, last;  // centreline vertex indices
+  double s0, s1;       // their arc lengths
+};
+
+std::vector<Piece> road_pieces(const RoadSpec& road) {
+  const Polyline2d& c = road.centreline;
+  std::vector<double> arc{0};
+  for (size_t i = 1; i < c.size(); ++i) arc.push_back(arc.back() + (c[i] - c[i - 1]).norm());
+  if (!road.closed) return {{0, c.size() - 1, 0, arc.back()}};
+  // A closed road in two halves at the vertex nearest half way round (a lanelet that is its own
+  // successor has no start, and Lanelet2's routing graph cannot order it).
+  size_t mid = 1;
+  for (size_t i = 1; i + 1 < c.size(); ++i)
+    if (std::abs(arc[i] - arc.back() / 2) < std::abs(arc[mid] - arc.back() / 2)) mid = i;
+  return {{0, mid, 0, arc[mid]}, {mid, c.size() - 1, arc[mid], arc.back()}};
+}
+
+// Signed arc length from a to b along the road (the short way round on a closed road).
+double along(const RoadSpec& road, double a, double b) {
+  double d = b - a;
+  if (road.closed) {
+    const double length = polyline_length(road.centreline);
+    d = std::remainder(d, length);
+  }
+  return d;
+}
+
+// A line across the carriageway at arc length s, from `from` to `to` (lateral offsets, left positive).
+Polyline2d across(const RoadSpec& road, double s, double from, double to) {
+  const PolylineSample at = sample_polyline(road.centreline, s);
+  const Eigen::Vector2d left(-at.tangent.y(), at.tangent.x());
+  return {at.point + left * from, at.point + left * to};
+}
+
+// Lateral extent of the carriageway's half that traffic in a direction uses.
+std::pair<double, double> travel_half(const RoadSpec& road, bool backward) {
+  const double half = road.width / 2;
+  if (road.one_way) return {-half, half};
+  return backward ? std::pair{0.0, half} : std::pair{-half, 0.0};
+}
+
+struct StopLine {
+  const RoadSpec* road;
+  double s;
+  RoadSide side;
+  int64_t way;
+};
+
+class MapBuilder {
+ public:
+  MapBuilder(const WorldDescription& world, const SurveyedLine& surveyed, const GroundHeight& height)
+      : world_(world), surveyed_(surveyed), osm_(world.origin, height) {}
+
+  void curbs(const CurbMap& curbs) {
+    for (size_t i = 0; i < curbs.curbs.size(); ++i) {
+      const std::string kind = i < curbs.kinds.size() ? curbs.kinds[i] : "vertical";
+      osm_.way(curbs.curbs[i], {{"type", "curbstone"}, {"subtype", curbstone_subtype(kind)}});
+      ++summary_.curbstones;
+    }
+  }
+
+  void stop_lines() {
+    for (const StopLineSpec& spec : world_.stop_lines) {
+      const RoadSpec& road = *world_.road(spec.road);
+      const double half = road.width / 2;
+      const double from = spec.side == RoadSide::left ? 0.0 : -half, to = spec.side == RoadSide::right ? 0.0 : half;
+      stop_lines_.push_back({&road, spec.at, spec.side, line(across(road, spec.at, from, to), stop_line_tags())});
+      ++summary_.stop_lines;
+    }
+  }
+
+  // Autoware's crosswalk (vector map requirement vm-05-01; extra_regulatory_elements.md, "Crosswalk"): a
+  // lanelet subtype=crosswalk, a crosswalk_polygon over the carriageway, stop lines before it, and a
+  // regulatory element subtype=crosswalk that refers to the lanelet and names the polygon and the stop
+  // lines (ref_line); the road's lanelets list the regulatory element (road_lanes does that).
+  void crosswalks() {
+    for (const CrosswalkSpec& cw : world_.crosswalks) {
+      const RoadSpec& road = *world_.road(cw.road);
+      const double half = road.width / 2, w = cw.width / 2;
+      // The pedestrians' line, right sidewalk to left (sim/path.hpp), widened to the crosswalk's width.
+      const Path walk = crosswalk_path(road, cw, false);
+      const Eigen::Vector2d t = sample_polyline(road.centreline, cw.at).tangent;
+      const Eigen::Vector2d a = walk.points.front(), b = walk.points.back();
+      // Walking from the right side to the left, the side towards lower arc length is on the left.
+      const int64_t left = line({a - t * w, b - t * w}, {{"type", "pedestrian_marking"}});
+      const int64_t right = line({a + t * w, b + t * w}, {{"type", "pedestrian_marking"}});
+      // Crosswalk lanelets are two-way and for pedestrians (Lanelet2 LaneletAndAreaTagging.md).
+      const int64_t lanelet = osm_.relation({Member(osmium::item_type::way, left, "left"),
+                                             Member(osmium::item_type::way, right, "right")},
+                                            {{"type", "lanelet"},
+                                             {"subtype", "crosswalk"},
+                                             {"location", "urban"},
+                                             {"one_way", "no"},
+                                             {"participant:pedestrian", "yes"}});
+      // An OSM polygon is a way tagged area=yes whose last node is not repeated (Lanelet2 OSM format;
+      // Autoware's examples of area ways in lanelet2_format_extension.md).
+      const Polyline2d poly = across(road, cw.at - cw.width / 2, -half, half);
+      const Polyline2d far = across(road, cw.at + cw.width / 2, half, -half);
+      const int64_t polygon =
+          line({poly[0], poly[1], far[0], far[1]}, {{"type", "crosswalk_polygon"}, {"area", "yes"}});
+      std::vector<Member> members = {Member(osmium::item_type::relation, lanelet, "refers"),
+                                     Member(osmium::item_type::way, polygon, "crosswalk_polygon")};
+      for (const bool backward : {false, true}) {
+        if (backward && road.one_way) continue;
+        members.emplace_back(osmium::item_type::way, stop_line_for(road, cw, backward), "ref_line");
+      }
+      const int64_t regulatory = osm_.relation(members, {{"type", "regulatory_element"}, {"subtype", "crosswalk"}});
+      crosswalk_elements_.push_back({&cw, regulatory});
+      ++summary_.crosswalks;
+    }
+  }
+
+  // Autoware's road lanelets (vm-01-01): subtype=road, location=urban, one_way=yes, speed_limit in km/h.
+  // Bounds are left and right of the direction of travel; Lanelet2's loader orients the two bounds by
+  // geometry (lanelet2_io OsmHandlerLoad.cpp: geometry::align), so a shared divider is one way.
+  void road_lanes() {
+    for (const RoadSpec& road : world_.roads) {
+      const double lane_width = road.width / road.lanes;
+      const std::vector<Piece> pieces = road_pieces(road);
+      // bounds[k][p]: the line k lanes from the right curb over piece p.
+      std::vector<std::vector<int64_t>> bounds(size_t(road.lanes) + 1);
+      for (int k = 0; k <= road.lanes; ++k) {
+        const Polyline2d offset = offset_polyline(road.centreline, -road.width / 2 + k * lane_width, road.closed);
+        const Tags tags = k == 0 || k == road.lanes ? Tags{{"type", "road_border"}} : divider_tags(road.marking);
+        for (const Piece& p : pieces)
+          bounds[size_t(k)].push_back(line(Polyline2d(offset.begin() + long(p.first), offset.begin() + long(p.last) + 1), tags));
+      }
+      for (int j = 0; j < road.lanes; ++j) {
+        const double centre = -road.width / 2 + (j + 0.5) * lane_width;
+        // Right-hand traffic: on a two-way road the lanes right of the centreline go along it; a lane on
+        // the centreline (one lane for both directions) is two-way.
+        const bool two_way = !road.one_way && std::abs(centre) < 1e-9;
+        const bool backward = !road.one_way && centre > 1e-9;
+        for (size_t p = 0; p < pieces.size(); ++p) {
+          const int64_t right_line = bounds[size_t(backward ? j + 1 : j)][p];
+          const int64_t left_line = bounds[size_t(backward ? j : j + 1)][p];
+          std::vector<Member> members = {Member(osmium::item_type::way, left_line, "left"),
+                                         Member(osmium::item_type::way, right_line, "right")};
+          for (const auto& [cw, regulatory] : crosswalk_elements_)
+            if (cw->road == road.name && crosses(road, pieces[p], *cw))
+              members.emplace_back(osmium::item_type::relation, regulatory, "regulatory_element");
+          osm_.relation(members, {{"type", "lanelet"},
+                                  {"subtype", "road"},
+                                  {"location", "urban"},
+                                  {"one_way", two_way ? "no" : "yes"},
+                                  {"speed_limit", shortest_decimal(road.design_speed)},
+                                  {"participant:vehicle", "yes"}});
+          ++summary_.road_lanelets;
+        }
+      }
+    }
+  }
+
+  Lanelet2Summary write(const std::string& path) {
+    osm_.write(path);
+    summary_.nodes = osm_.nodes();
+    return summary_;
+  }
+
+ private:
+  static Tags stop_line_tags() { return {{"type", "stop_line"}}; }
+
+  // A line of the world, where the survey put it.
+  int64_t line(const Polyline2d& world_line, const Tags& tags) { return osm_.way(surveyed_(world_line), tags); }
+
+  static bool crosses(const RoadSpec& road, const Piece& piece, const CrosswalkSpec& cw) {
+    return along(road, piece.s0, cw.at + cw.width / 2) >= 0 && along(road, cw.at - cw.width / 2, piece.s1) >= 0;
+  }
+
+  // The world's stop line for traffic approaching the crosswalk in this direction, or one derived
+  // kDerivedStopDistance before the crosswalk.
+  int64_t stop_line_for(const RoadSpec& road, const CrosswalkSpec& cw, bool backward) {
+    const RoadSide half = backward ? RoadSide::left : RoadSide::right;
+    const double edge = backward ? cw.at + cw.width / 2 : cw.at - cw.width / 2;
+    for (const StopLine& s : stop_lines_) {
+      if (s.road != &road || (s.side != half && s.side != RoadSide::both)) continue;
+      const double before = backward ? along(road, edge, s.s) : along(road, s.s, edge);
+      if (before >= 0 && before <= kCrosswalkStopLineReach) return s.way;
+    }
+    const double s = backward ? edge + kDerivedStopDistance : edge - kDerivedStopDistance;
+    const auto [from, to] = travel_half(road, backward);
+    ++summary_.derived_stop_lines;
+    return line(across(road, s, from, to), stop_line_tags());
+  }
+
+  const WorldDescription& world_;
+  const SurveyedLine& surveyed_;
+  OsmDocument osm_;
+  Lanelet2Summary summary_;
+  std::vector<StopLine> stop_lines_;
+  std::vector<std::pair<const CrosswalkSpec*, int64_t>> crosswalk_elements_;
+};
+
+}  // namespace
+
+const char* curbstone_subtype(const std::string& kind) {
+  // Lanelet2 LinestringTagging.md: `high` is too high for a vehicle to drive over, `low` can be driven
+  // over. A vertical (barrier) curb is high; sloped and rolled curbs are mountable (AASHTO 4.7) and a cut
+  // is level with the road, so they are low.
+  return kind == "vertical" ? "high" : "low";
+}
+
+Lanelet2Summary write_lanelet2_map(const std::string& path, const WorldDescription& world, const CurbMap& curbs,
+                                   const SurveyedLine& surveyed, const GroundHeight& height) {
+  MapBuilder builder(world, surveyed, height);
+  builder.curbs(curbs);
+  builder.stop_lines();
+  builder.crosswalks();  // before the lanes, which list the crosswalks' regulatory elements
+  builder.road_lanes();
+  return builder.write(path);
+}
+
+}  // namespace lidarloop
