@@ -14,8 +14,8 @@
 
 #include "common/input_error.hpp"
 #include "logs/log_topics.hpp"
-#include "logs/pcd_file.hpp"
 #include "logs/mcap/mcap_reader.hpp"
+#include "logs/pcd_file.hpp"
 #include "logs/ros2_messages.hpp"
 #include "logs/tum_file.hpp"
 
@@ -105,9 +105,9 @@ ExportResult export_pcd(const std::string& log, const std::string& dir, const st
   for (McapMessage m; reader.next(m);) {
     if (m.channel->topic != chosen || !has_type(m, "sensor_msgs/msg/PointCloud2")) continue;
     const PointCloud cloud = ros2::decode_point_cloud(m.data, context(reader, m));
-    const std::string h = binary_pcd_header(
-        {{"x"}, {"y"}, {"z"}, {"intensity"}, {"ring", 2, 'U'}, {"time"}}, cloud.points.size(),
-        "lidarloop scan, stamp " + std::to_string(cloud.stamp_ns) + " ns");
+    const std::string h =
+        binary_pcd_header({{"x"}, {"y"}, {"z"}, {"intensity"}, {"ring", 2, 'U'}, {"time"}}, cloud.points.size(),
+                          "lidarloop scan, stamp " + std::to_string(cloud.stamp_ns) + " ns");
     body.clear();
     body.reserve(cloud.points.size() * 22);
     for (const LidarPoint& p : cloud.points) {

@@ -14,8 +14,8 @@ std::string binary_pcd_header(const std::vector<PcdField>& fields, size_t points
   }
   std::ostringstream head;
   head << "# .PCD v0.7 - " << comment << "\nVERSION 0.7\nFIELDS" << names.str() << "\nSIZE" << sizes.str() << "\nTYPE"
-       << types.str() << "\nCOUNT" << counts.str() << "\nWIDTH " << points << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
-       << points << "\nDATA binary\n";
+       << types.str() << "\nCOUNT" << counts.str() << "\nWIDTH " << points
+       << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << points << "\nDATA binary\n";
   return head.str();
 }
 

@@ -8,7 +8,8 @@
 //   lanelet2_map.osm         the vector map (loop/lanelet2_map.hpp);
 //   map_projector_info.yaml  how Autoware turns lat/lon into the map frame (autoware_map_projection_loader).
 // No pointcloud_map_metadata.yaml: that is for a point cloud divided into several files, and one file
-// loads without it.
+// loads without it. No map_config.yaml either: the map loaders' parameters (leaf sizes, projector
+// options) come from autoware_launch's config/map/*.param.yaml, not from the map folder.
 #include <cstddef>
 #include <string>
 

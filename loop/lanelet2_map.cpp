@@ -13,6 +13,7 @@
 
 #include "common/input_error.hpp"
 #include "localizer/map_files.hpp"
+#include "sim/curb_band.hpp"
 #include "sim/path.hpp"
 #include "sim/polyline.hpp"
 
@@ -135,8 +136,13 @@ double along(const RoadSpec& road, double a, double b) {
   return d;
 }
 
-// A line across the carriageway at arc length s, from `from` to `to` (lateral offsets, left positive).
+// A line across the carriageway at arc length s (round a closed road's start if past it), from `from` to
+// `to` (lateral offsets, left positive).
 Polyline2d across(const RoadSpec& road, double s, double from, double to) {
+  if (road.closed) {
+    const double length = polyline_length(road.centreline);
+    s -= length * std::floor(s / length);
+  }
   const PolylineSample at = sample_polyline(road.centreline, s);
   const Eigen::Vector2d left(-at.tangent.y(), at.tangent.x());
   return {at.point + left * from, at.point + left * to};
@@ -163,7 +169,8 @@ class MapBuilder {
 
   void curbs(const CurbMap& curbs) {
     for (size_t i = 0; i < curbs.curbs.size(); ++i) {
-      const std::string kind = i < curbs.kinds.size() ? curbs.kinds[i] : "vertical";
+      // A map that does not say what its curbs are: taken as barrier curbs, which nothing drives over.
+      const std::string kind = i < curbs.kinds.size() ? curbs.kinds[i] : curb_profile_name(CurbProfile::vertical);
       osm_.way(curbs.curbs[i], {{"type", "curbstone"}, {"subtype", curbstone_subtype(kind)}});
       ++summary_.curbstones;
     }
@@ -195,13 +202,13 @@ class MapBuilder {
       const int64_t left = line({a - t * w, b - t * w}, {{"type", "pedestrian_marking"}});
       const int64_t right = line({a + t * w, b + t * w}, {{"type", "pedestrian_marking"}});
       // Crosswalk lanelets are two-way and for pedestrians (Lanelet2 LaneletAndAreaTagging.md).
-      const int64_t lanelet = osm_.relation({Member(osmium::item_type::way, left, "left"),
-                                             Member(osmium::item_type::way, right, "right")},
-                                            {{"type", "lanelet"},
-                                             {"subtype", "crosswalk"},
-                                             {"location", "urban"},
-                                             {"one_way", "no"},
-                                             {"participant:pedestrian", "yes"}});
+      const int64_t lanelet =
+          osm_.relation({Member(osmium::item_type::way, left, "left"), Member(osmium::item_type::way, right, "right")},
+                        {{"type", "lanelet"},
+                         {"subtype", "crosswalk"},
+                         {"location", "urban"},
+                         {"one_way", "no"},
+                         {"participant:pedestrian", "yes"}});
       // An OSM polygon is a way tagged area=yes whose last node is not repeated (Lanelet2 OSM format;
       // Autoware's examples of area ways in lanelet2_format_extension.md).
       const Polyline2d poly = across(road, cw.at - cw.width / 2, -half, half);
@@ -233,7 +240,8 @@ class MapBuilder {
         const Polyline2d offset = offset_polyline(road.centreline, -road.width / 2 + k * lane_width, road.closed);
         const Tags tags = k == 0 || k == road.lanes ? Tags{{"type", "road_border"}} : divider_tags(road.marking);
         for (const Piece& p : pieces)
-          bounds[size_t(k)].push_back(line(Polyline2d(offset.begin() + long(p.first), offset.begin() + long(p.last) + 1), tags));
+          bounds[size_t(k)].push_back(
+              line(Polyline2d(offset.begin() + long(p.first), offset.begin() + long(p.last) + 1), tags));
       }
       for (int j = 0; j < road.lanes; ++j) {
         const double centre = -road.width / 2 + (j + 0.5) * lane_width;
@@ -307,7 +315,7 @@ const char* curbstone_subtype(const std::string& kind) {
   // Lanelet2 LinestringTagging.md: `high` is too high for a vehicle to drive over, `low` can be driven
   // over. A vertical (barrier) curb is high; sloped and rolled curbs are mountable (AASHTO 4.7) and a cut
   // is level with the road, so they are low.
-  return kind == "vertical" ? "high" : "low";
+  return kind == curb_profile_name(CurbProfile::vertical) ? "high" : "low";
 }
 
 Lanelet2Summary write_lanelet2_map(const std::string& path, const WorldDescription& world, const CurbMap& curbs,

@@ -79,17 +79,20 @@ std::optional<std::string> export_dir(const Args& args) {
   if (!format && has_dir) throw InputError("a second argument (a folder) goes with --export FORMAT");
   if (!format) return std::nullopt;
   if (*format != "autoware") throw InputError("--export: unknown format '" + *format + "' (known: autoware)");
-  if (!has_dir) throw InputError("--export " + *format + " needs a folder: lidarloop map WORLD --export " + *format + " DIR");
+  if (!has_dir)
+    throw InputError("--export " + *format + " needs a folder: lidarloop map WORLD --export " + *format + " DIR");
   make_export_folder(args.positional().at(1));
   return args.positional().at(1);
 }
 
 void print_export(const AutowareExportSummary& e) {
   const Lanelet2Summary& l = e.lanelet2;
-  std::cout << "autoware     " << e.dir << ": " << kAutowarePointCloudFile << " (" << e.points << " points), "
-            << kAutowareLanelet2File << " (" << l.road_lanelets << " lanelets, " << l.curbstones << " curbstones, "
-            << l.crosswalks << " crosswalks, " << l.stop_lines << " stop lines of the world and "
-            << l.derived_stop_lines << " derived before crosswalks), " << kAutowareProjectorFile << "\n";
+  std::cout << "autoware     " << e.dir << "/{" << kAutowarePointCloudFile << ", " << kAutowareLanelet2File << ", "
+            << kAutowareProjectorFile << "}\n"
+            << "  points     " << e.points << "\n"
+            << "  lanelet2   road lanelets " << l.road_lanelets << ", curbstones " << l.curbstones << ", crosswalks "
+            << l.crosswalks << ", stop lines " << l.stop_lines << " + " << l.derived_stop_lines
+            << " derived before crosswalks, nodes " << l.nodes << "\n";
 }
 
 int run_map(const Args& args) {
@@ -105,7 +108,11 @@ int run_map(const Args& args) {
             << " m cells; mean.png, variance.png\n"
             << "curbs        " << loc.dir << "/curbs.geojson\n";
   print_survey(args.positional().at(0), options, loc.dir);
-  if (out) print_export(export_autoware_map(args.positional().at(0), options, loc.dir, *out));
+  if (out) {
+    AutowareExportConfig config;
+    config.voxel_m = args.number("export-voxel", config.voxel_m);
+    print_export(export_autoware_map(args.positional().at(0), options, loc.dir, *out, config));
+  }
   return 0;
 }
 
@@ -177,7 +184,8 @@ Command map_command() {
             {"realism", "PROFILE", "the survey of a realism profile: ideal, typical (default) or harsh"},
             {"survey", "FILE", "survey settings in YAML (unit_serial, sigma_xy_m, heading_sigma_deg, ...)"},
             {"threads", "N", "worker threads (default: all cores)"},
-            {"export", "FORMAT", "also write the map for another program into the folder given after it: autoware"}},
+            {"export", "FORMAT", "also write the map for another program into the folder given after it: autoware"},
+            {"export-voxel", "M", "voxel of the exported point cloud (default 0.4 m, the point layer's; not finer)"}},
            1,
            2},
           run_map};

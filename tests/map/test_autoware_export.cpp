@@ -1,6 +1,7 @@
 // `lidarloop map --export autoware` on the 100 m road of tests/data (its map builds in seconds): the
 // Lanelet2 map read back with libosmium, an independent OSM reader, against the map's GeoJSON curbs and
 // the world; the point cloud map's PCD header and a surface of the world in it.
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -74,7 +75,9 @@ class AutowareExport : public ::testing::Test {
   static void SetUpTestSuite() {
     world_ = std::string(LIDARLOOP_DATA_DIR) + "/tests/data/short_road_world.yaml";
     map_ = ensure_map(world_, options_, false).dir;
-    out_ = (std::filesystem::temp_directory_path() / "lidarloop_autoware_export").string();
+    // A folder of this process's own: ctest runs each test case as a process, two at a time.
+    out_ =
+        (std::filesystem::temp_directory_path() / ("lidarloop_autoware_export_" + std::to_string(::getpid()))).string();
     std::filesystem::remove_all(out_);
     summary_ = export_autoware_map(world_, options_, map_, out_);
     osmium::io::Reader reader(out_ + "/" + kAutowareLanelet2File);
@@ -82,6 +85,7 @@ class AutowareExport : public ::testing::Test {
     osmium::apply(reader, osm_);
     reader.close();
   }
+  static void TearDownTestSuite() { std::filesystem::remove_all(out_); }
 
   Eigen::Vector2d local_of(const OsmNode& n) const {
     return LocalFrame(read_curb_map(map_ + "/curbs.geojson").origin).to_local(n.lat, n.lon);
@@ -147,16 +151,23 @@ TEST_F(AutowareExport, CurbstonesAreTheGeoJsonCurbs) {
 TEST_F(AutowareExport, LaneletsHaveBoundsOnTheirSides) {
   for (const auto& [id, r] : osm_.relations) {
     if (r.tags.at("type") != "lanelet") continue;
-    EXPECT_EQ(std::count_if(r.members.begin(), r.members.end(), [](const OsmMember& m) { return m.role == "left"; }), 1);
-    EXPECT_EQ(std::count_if(r.members.begin(), r.members.end(), [](const OsmMember& m) { return m.role == "right"; }), 1);
+    for (const char* role : {"left", "right"}) {
+      EXPECT_EQ(std::count_if(r.members.begin(), r.members.end(), [&](const OsmMember& m) { return m.role == role; }),
+                1)
+          << "lanelet " << id << " " << role;
+      for (const OsmMember& m : r.members) {
+        if (m.role != role) continue;
+        EXPECT_TRUE(m.type == 'w' && osm_.ways.count(m.ref)) << "lanelet " << id << " " << role;
+      }
+    }
   }
   const auto roads = lanelets("road");
   ASSERT_EQ(roads.size(), 2u);  // two lanes, one each way
   EXPECT_EQ(summary_.lanelet2.road_lanelets, 2u);
   for (const OsmRelation* r : roads) {
     const double left = mean_y(member_way(*r, "left")), right = mean_y(member_way(*r, "right"));
-    EXPECT_NEAR(left, 0.0, 0.1);                     // the centre line (the survey moves it by cm)
-    EXPECT_NEAR(std::abs(right), 4.0, 0.1);          // the curb, 8 m road
+    EXPECT_NEAR(left, 0.0, 0.1);             // the centre line (the survey moves it by cm)
+    EXPECT_NEAR(std::abs(right), 4.0, 0.1);  // the curb, 8 m road
     EXPECT_EQ(member_way(*r, "left").tags.at("subtype"), "dashed");
     EXPECT_EQ(member_way(*r, "right").tags.at("type"), "road_border");
     EXPECT_EQ(r->tags.at("one_way"), "yes");
@@ -256,6 +267,8 @@ TEST_F(AutowareExport, PointCloudHasTheRoad) {
   ASSERT_GT(road_z.size(), 100u);
   std::nth_element(road_z.begin(), road_z.begin() + long(road_z.size() / 2), road_z.end());
   EXPECT_NEAR(road_z[road_z.size() / 2], 0.0, 0.02);
+  std::cout << "median z of " << road_z.size() << " points over the road's middle: " << road_z[road_z.size() / 2]
+            << " m\n";
   EXPECT_GT(double(with_intensity), 0.9 * double(road_z.size()));
 }
 
