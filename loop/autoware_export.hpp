@@ -3,8 +3,9 @@
 // (autoware_launch map.launch.xml, `map_path:=DIR`) loads, under its default file names:
 //   pointcloud_map.pcd       the survey's point cloud layer (localizer/point_map.hpp: the mapping drive's
 //                            scans placed with the survey poses, one centroid per voxel), re-voxelized
-//                            to `voxel_m`, as binary PCD with fields x y z intensity (float32), what
-//                            Autoware's pointcloud_map_loader and NDT read (pcl::PointXYZI);
+//                            to `voxel_m`, as binary PCD with fields x y z intensity (float32, the
+//                            layout of pcl::PointXYZI) that Autoware's pointcloud_map_loader reads with
+//                            PCL: NDT registers against x y z, intensity is for display;
 //   lanelet2_map.osm         the vector map (loop/lanelet2_map.hpp);
 //   map_projector_info.yaml  how Autoware turns lat/lon into the map frame (autoware_map_projection_loader).
 // No pointcloud_map_metadata.yaml: that is for a point cloud divided into several files, and one file

@@ -34,10 +34,10 @@ constexpr double kDerivedStopDistance = 3.5;
 constexpr double kCrosswalkStopLineReach = 10.0;
 constexpr size_t kInitialBufferBytes = size_t(1) << 20;  // libosmium buffers grow from here
 
-// One OSM document under construction. Lanelet2 keeps points, line strings and relations in one id
-// space (lanelet2_core: utils::getId() draws every primitive's id from one counter), so every object
-// takes the next id; nodes at the same place are one node, so bounds that meet share their ends, which
-// is how Lanelet2's routing finds a lane's successor (lanelet2_routing: "follows" compares end points).
+// One OSM document under construction. In Lanelet2 "everything that has an ID is unique across the
+// whole map" (lanelet2_core/doc/Architecture.md), so every object takes the next id of one counter.
+// Nodes at the same place are one node, so bounds that meet share their ends: that is how Lanelet2
+// finds a lane's successor (lanelet2_core geometry::follows compares the bounds' end points).
 class OsmDocument {
  public:
   OsmDocument(const Geodetic& origin, GroundHeight height) : frame_(origin), height_(std::move(height)) {}
