@@ -96,8 +96,8 @@ AutowareExportSummary export_autoware_map(const std::string& world, const Mappin
     const CurbMap one{w.world.origin, w.world.name, {line}, {}};
     return survey_curb_map(densify_curb_map(one, options.survey_error.sample_spacing_m), survey).curbs.front();
   };
-  summary.lanelet2 = write_lanelet2_map(out_dir + "/" + kAutowareLanelet2File, w.description,
-                                        read_curb_map(map_dir + "/curbs.geojson"), surveyed, w.world.pavement());
+  summary.lanelet2 = write_lanelet2_map(out_dir + "/" + kAutowareLanelet2File, w.description, w.world,
+                                        read_curb_map(map_dir + "/curbs.geojson"), surveyed);
   write_projector_info(out_dir + "/" + kAutowareProjectorFile, w.world.origin);
   return summary;
 }

@@ -107,23 +107,68 @@ Tags divider_tags(MarkingStyle style) {
   return {{"type", "line_thin"}, {"subtype", style == MarkingStyle::dashed ? "dashed" : "solid"}};
 }
 
-// A stretch of a road between two centreline vertices: lanelets are cut where the road is.
+// A stretch of a road between two vertices of its (cut) centreline: lanelets are cut where the road's
+// edges open into another road's carriageway (a junction's mouth) and where they close again.
 struct Piece {
-  size_t first, last;  // centreline vertex indices
-  double s0, s1;       // their arc lengths
+  size_t first, last;                          // centreline vertex indices
+  double s0, s1;                               // their arc lengths
+  bool open_right = false, open_left = false;  // the edge runs across another road's carriageway
 };
 
-std::vector<Piece> road_pieces(const RoadSpec& road) {
+// Junction mouths are found by probing this far beyond the carriageway's edge every kMouthStep along
+// the road: past the edge is curb unless another road's carriageway is there. 0.5 m is beyond the
+// rounding of the carriageway's outline; the mouth's ends are placed to kMouthStep.
+constexpr double kMouthProbe = 0.5, kMouthStep = 0.5;
+
+bool edge_open(const RoadSpec& road, const region::Paths& carriageway, double s, double side) {
+  const PolylineSample at = sample_polyline(road.centreline, s);
+  const Eigen::Vector2d left(-at.tangent.y(), at.tangent.x());
+  return region::contains(carriageway, at.point + left * side * (road.width / 2 + kMouthProbe));
+}
+
+// The road's centreline with a vertex added at every cut (arc lengths, sorted, inside the line; a vertex
+// on a straight stretch leaves every offset line as it was), and the pieces between the cuts.
+std::pair<Polyline2d, std::vector<Piece>> cut_road(const RoadSpec& road, const region::Paths& carriageway) {
   const Polyline2d& c = road.centreline;
+  const double length = polyline_length(c);
+  std::vector<double> cuts;
+  auto state = [&](double s) {
+    return std::pair{edge_open(road, carriageway, s, -1), edge_open(road, carriageway, s, 1)};
+  };
+  for (double s = kMouthStep; s <= length; s += kMouthStep)
+    if (state(s) != state(s - kMouthStep)) cuts.push_back(s - kMouthStep / 2);
+  // A closed road without junctions is cut half way round: a lanelet that is its own successor has no
+  // start, and Lanelet2's routing graph cannot order it.
+  if (road.closed && cuts.empty()) {
+    cuts.push_back(length / 2);
+  }
+  // A cut this close to a vertex is at the vertex: no segment of zero length, whose normal is undefined.
+  constexpr double kSameArc = 1e-6;
+  Polyline2d line{c.front()};
+  std::vector<size_t> at{0};
   std::vector<double> arc{0};
-  for (size_t i = 1; i < c.size(); ++i) arc.push_back(arc.back() + (c[i] - c[i - 1]).norm());
-  if (!road.closed) return {{0, c.size() - 1, 0, arc.back()}};
-  // A closed road in two halves at the vertex nearest half way round (a lanelet that is its own
-  // successor has no start, and Lanelet2's routing graph cannot order it).
-  size_t mid = 1;
-  for (size_t i = 1; i + 1 < c.size(); ++i)
-    if (std::abs(arc[i] - arc.back() / 2) < std::abs(arc[mid] - arc.back() / 2)) mid = i;
-  return {{0, mid, 0, arc[mid]}, {mid, c.size() - 1, arc[mid], arc.back()}};
+  double s0 = 0;
+  size_t next = 0;
+  for (size_t i = 1; i < c.size(); ++i) {
+    const double s1 = s0 + (c[i] - c[i - 1]).norm();
+    for (; next < cuts.size() && cuts[next] < s1 - kSameArc; ++next) {
+      if (cuts[next] <= arc.back() + kSameArc) continue;  // a cut made already
+      if (cuts[next] > s0 + kSameArc) line.push_back(c[i - 1] + (c[i] - c[i - 1]) * ((cuts[next] - s0) / (s1 - s0)));
+      if (at.back() == line.size() - 1) continue;
+      at.push_back(line.size() - 1);
+      arc.push_back(std::max(cuts[next], s0));
+    }
+    line.push_back(c[i]);
+    s0 = s1;
+  }
+  at.push_back(line.size() - 1);
+  arc.push_back(s0);
+  std::vector<Piece> pieces;
+  for (size_t k = 0; k + 1 < at.size(); ++k) {
+    const auto [right, left] = state((arc[k] + arc[k + 1]) / 2);
+    pieces.push_back({at[k], at[k + 1], arc[k], arc[k + 1], right, left});
+  }
+  return {line, pieces};
 }
 
 // Signed arc length from a to b along the road (the short way round on a closed road).
@@ -164,8 +209,8 @@ struct StopLine {
 
 class MapBuilder {
  public:
-  MapBuilder(const WorldDescription& world, const SurveyedLine& surveyed, const GroundHeight& height)
-      : world_(world), surveyed_(surveyed), osm_(world.origin, height) {}
+  MapBuilder(const WorldDescription& world, const World& built, const SurveyedLine& surveyed)
+      : world_(world), carriageway_(built.carriageway), surveyed_(surveyed), osm_(world.origin, built.pavement()) {}
 
   void curbs(const CurbMap& curbs) {
     for (size_t i = 0; i < curbs.curbs.size(); ++i) {
@@ -229,19 +274,26 @@ class MapBuilder {
 
   // Autoware's road lanelets (vm-01-01): subtype=road, location=urban, one_way=yes, speed_limit in km/h.
   // Bounds are left and right of the direction of travel; Lanelet2's loader orients the two bounds by
-  // geometry (lanelet2_io OsmHandlerLoad.cpp: geometry::align), so a shared divider is one way.
+  // geometry (lanelet2_io OsmHandlerLoad.cpp: geometry::align), so a shared divider is one way. Where an
+  // edge opens into another road the bound is virtual (LinestringTagging.md: "mainly for intersections")
+  // and the lanelet, in the intersection, goes straight on (Autoware vm-03-02: every lanelet in an
+  // intersection has a turn_direction).
   void road_lanes() {
     for (const RoadSpec& road : world_.roads) {
       const double lane_width = road.width / road.lanes;
-      const std::vector<Piece> pieces = road_pieces(road);
+      const auto [centreline, pieces] = cut_road(road, carriageway_);
       // bounds[k][p]: the line k lanes from the right curb over piece p.
       std::vector<std::vector<int64_t>> bounds(size_t(road.lanes) + 1);
       for (int k = 0; k <= road.lanes; ++k) {
-        const Polyline2d offset = offset_polyline(road.centreline, -road.width / 2 + k * lane_width, road.closed);
-        const Tags tags = k == 0 || k == road.lanes ? Tags{{"type", "road_border"}} : divider_tags(road.marking);
-        for (const Piece& p : pieces)
+        const Polyline2d offset = offset_polyline(centreline, -road.width / 2 + k * lane_width, road.closed);
+        for (const Piece& p : pieces) {
+          const bool edge = k == 0 || k == road.lanes, open = k == 0 ? p.open_right : p.open_left;
+          const Tags tags = !edge  ? divider_tags(road.marking)
+                            : open ? Tags{{"type", "virtual"}}
+                                   : Tags{{"type", "road_border"}};
           bounds[size_t(k)].push_back(
               line(Polyline2d(offset.begin() + long(p.first), offset.begin() + long(p.last) + 1), tags));
+        }
       }
       for (int j = 0; j < road.lanes; ++j) {
         const double centre = -road.width / 2 + (j + 0.5) * lane_width;
@@ -257,12 +309,17 @@ class MapBuilder {
           for (const auto& [cw, regulatory] : crosswalk_elements_)
             if (cw->road == road.name && crosses(road, pieces[p], *cw))
               members.emplace_back(osmium::item_type::relation, regulatory, "regulatory_element");
-          osm_.relation(members, {{"type", "lanelet"},
-                                  {"subtype", "road"},
-                                  {"location", "urban"},
-                                  {"one_way", two_way ? "no" : "yes"},
-                                  {"speed_limit", shortest_decimal(road.design_speed)},
-                                  {"participant:vehicle", "yes"}});
+          Tags tags = {{"type", "lanelet"},
+                       {"subtype", "road"},
+                       {"location", "urban"},
+                       {"one_way", two_way ? "no" : "yes"},
+                       {"speed_limit", shortest_decimal(road.design_speed)},
+                       {"participant:vehicle", "yes"}};
+          if (pieces[p].open_right || pieces[p].open_left) {
+            tags.emplace_back("turn_direction", "straight");
+            ++summary_.intersection_lanelets;
+          }
+          osm_.relation(members, tags);
           ++summary_.road_lanelets;
         }
       }
@@ -302,6 +359,7 @@ class MapBuilder {
   }
 
   const WorldDescription& world_;
+  const region::Paths& carriageway_;
   const SurveyedLine& surveyed_;
   OsmDocument osm_;
   Lanelet2Summary summary_;
@@ -318,9 +376,9 @@ const char* curbstone_subtype(const std::string& kind) {
   return kind == curb_profile_name(CurbProfile::vertical) ? "high" : "low";
 }
 
-Lanelet2Summary write_lanelet2_map(const std::string& path, const WorldDescription& world, const CurbMap& curbs,
-                                   const SurveyedLine& surveyed, const GroundHeight& height) {
-  MapBuilder builder(world, surveyed, height);
+Lanelet2Summary write_lanelet2_map(const std::string& path, const WorldDescription& world, const World& built,
+                                   const CurbMap& curbs, const SurveyedLine& surveyed) {
+  MapBuilder builder(world, built, surveyed);
   builder.curbs(curbs);
   builder.stop_lines();
   builder.crosswalks();  // before the lanes, which list the crosswalks' regulatory elements

@@ -10,7 +10,9 @@
 //     the lane's bounds: the lane markings between lanes (type=line_thin, subtype=dashed|solid as the
 //     road's `marking`, type=virtual where it has none) and the carriageway's edges (type=road_border:
 //     the curbs themselves are split wherever their kind changes and go round corners, so no one curb
-//     runs along a whole lane). Closed roads are cut in two, so no lanelet ends where it starts;
+//     runs along a whole lane; type=virtual across a junction's mouth). A road's lanelets are cut where
+//     its edges open into another road and close again, and closed roads at least in two, so no
+//     lanelet ends where it starts; lanelets in a junction go straight (turn_direction=straight);
 //   - every curb line of the surveyed curb map as a way type=curbstone, subtype=high (vertical curbs)
 //     or low (sloped, rolled, and cuts: what a vehicle can drive over);
 //   - the world's stop lines (type=stop_line), and for every crosswalk a crosswalk lanelet, its polygon
@@ -28,24 +30,25 @@
 #include <string>
 
 #include "common/curb_map_file.hpp"
-#include "sim/road_surface.hpp"
-#include "sim/world_description.hpp"
+#include "sim/world_builder.hpp"
 
 namespace lidarloop {
 
 struct Lanelet2Summary {
   size_t nodes = 0, road_lanelets = 0, crosswalks = 0, curbstones = 0;
-  size_t stop_lines = 0;          // the world's
-  size_t derived_stop_lines = 0;  // made in front of crosswalks that had none
+  size_t intersection_lanelets = 0;  // road lanelets in a junction (an edge open to another road)
+  size_t stop_lines = 0;             // the world's
+  size_t derived_stop_lines = 0;     // made in front of crosswalks that had none
 };
 
 // Where the survey put a line of the world (densified and moved by the survey error).
 using SurveyedLine = std::function<Polyline2d(const Polyline2d&)>;
 
-// Writes the map to `path`. `curbs` is the surveyed curb map (the map's curbs.geojson) with its kinds;
-// `height` gives each node's ele. InputError naming the file if it cannot be written.
-Lanelet2Summary write_lanelet2_map(const std::string& path, const WorldDescription& world, const CurbMap& curbs,
-                                   const SurveyedLine& surveyed, const GroundHeight& height);
+// Writes the map of `world` (built as `built`: its carriageway finds the junctions, its pavement gives
+// each node's ele) to `path`. `curbs` is the surveyed curb map (the map's curbs.geojson) with its kinds.
+// InputError naming the file if it cannot be written.
+Lanelet2Summary write_lanelet2_map(const std::string& path, const WorldDescription& world, const World& built,
+                                   const CurbMap& curbs, const SurveyedLine& surveyed);
 
 // The Lanelet2 curbstone subtype of a curb kind (CurbMap::kinds).
 const char* curbstone_subtype(const std::string& kind);

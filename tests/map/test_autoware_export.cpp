@@ -22,6 +22,7 @@
 #include "loop/autoware_export.hpp"
 #include "loop/map_cache.hpp"
 #include "sim/polyline.hpp"
+#include "sim/world_assets.hpp"
 
 namespace lidarloop {
 namespace {
@@ -70,6 +71,14 @@ struct OsmMap : osmium::handler::Handler {
   }
 };
 
+OsmMap read_osm(const std::string& path) {
+  OsmMap osm;
+  osmium::io::Reader reader(path);
+  osmium::apply(reader, osm);
+  reader.close();
+  return osm;
+}
+
 class AutowareExport : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -80,10 +89,7 @@ class AutowareExport : public ::testing::Test {
         (std::filesystem::temp_directory_path() / ("lidarloop_autoware_export_" + std::to_string(::getpid()))).string();
     std::filesystem::remove_all(out_);
     summary_ = export_autoware_map(world_, options_, map_, out_);
-    osmium::io::Reader reader(out_ + "/" + kAutowareLanelet2File);
-    osm_ = OsmMap{};
-    osmium::apply(reader, osm_);
-    reader.close();
+    osm_ = read_osm(out_ + "/" + kAutowareLanelet2File);
   }
   static void TearDownTestSuite() { std::filesystem::remove_all(out_); }
 
@@ -270,6 +276,46 @@ TEST_F(AutowareExport, PointCloudHasTheRoad) {
   std::cout << "median z of " << road_z.size() << " points over the road's middle: " << road_z[road_z.size() / 2]
             << " m\n";
   EXPECT_GT(double(with_intensity), 0.9 * double(road_z.size()));
+}
+
+// A side road meeting the main road in a T (the world alone, no survey): where an edge of a road opens
+// into the other road its bound is virtual, elsewhere road_border, and the lanelets there go straight.
+TEST(Lanelet2Map, JunctionMouthsAreVirtual) {
+  const LoadedWorld w = load_world(std::string(LIDARLOOP_DATA_DIR) + "/tests/data/t_junction_world.yaml");
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("lidarloop_t_junction_" + std::to_string(::getpid()) + ".osm"))
+          .string();
+  const Lanelet2Summary summary =
+      write_lanelet2_map(path, w.description, w.world, w.world.curb_map(), [](const Polyline2d& l) { return l; });
+  const OsmMap osm = read_osm(path);
+  std::filesystem::remove(path);
+  const LocalFrame frame(w.description.origin);
+  std::vector<Polyline2d> virtual_lines;
+  size_t borders = 0;
+  for (const auto& [id, way] : osm.ways) {
+    if (way.tags.at("type") == "road_border") ++borders;
+    if (way.tags.at("type") != "virtual") continue;
+    Polyline2d line;
+    for (const int64_t n : way.nodes) line.push_back(frame.to_local(osm.nodes.at(n).lat, osm.nodes.at(n).lon));
+    virtual_lines.push_back(line);
+  }
+  // Main: three pieces, the middle one open on its north edge; side: two pieces, the first (inside the
+  // main road's carriageway) open on both edges.
+  EXPECT_EQ(summary.road_lanelets, 2u * 3 + 2u * 2);
+  EXPECT_EQ(summary.intersection_lanelets, 2u + 2u);
+  EXPECT_EQ(borders, 5u + 2u);
+  ASSERT_EQ(virtual_lines.size(), 3u);
+  size_t across_mouth = 0;
+  for (const Polyline2d& line : virtual_lines) {
+    const auto [lo, hi] = std::minmax({line.front().x(), line.back().x()});
+    // The main road's north edge (y 4) across the side road's carriageway (x 46-54) and its corners.
+    if (std::abs(line.front().y() - 4.0) < 0.01 && lo < 46 && hi > 54) ++across_mouth;
+  }
+  EXPECT_EQ(across_mouth, 1u);
+  size_t straight = 0;
+  for (const auto& [id, r] : osm.relations)
+    straight += r.tags.count("turn_direction") && r.tags.at("turn_direction") == "straight";
+  EXPECT_EQ(straight, summary.intersection_lanelets);
 }
 
 }  // namespace
