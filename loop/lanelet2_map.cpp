@@ -120,10 +120,14 @@ struct Piece {
 // rounding of the carriageway's outline; the mouth's ends are placed to kMouthStep.
 constexpr double kMouthProbe = 0.5, kMouthStep = 0.5;
 
-bool edge_open(const RoadSpec& road, const region::Paths& carriageway, double s, double side) {
+// The point `offset` metres left of a road's centreline (right if negative) at arc length s.
+Eigen::Vector2d beside(const RoadSpec& road, double s, double offset) {
   const PolylineSample at = sample_polyline(road.centreline, s);
-  const Eigen::Vector2d left(-at.tangent.y(), at.tangent.x());
-  return region::contains(carriageway, at.point + left * side * (road.width / 2 + kMouthProbe));
+  return at.point + Eigen::Vector2d(-at.tangent.y(), at.tangent.x()) * offset;
+}
+
+bool edge_open(const RoadSpec& road, const region::Paths& carriageway, double s, double side) {
+  return region::contains(carriageway, beside(road, s, side * (road.width / 2 + kMouthProbe)));
 }
 
 // The road's centreline with a vertex added at every cut (arc lengths, sorted, inside the line; a vertex
@@ -188,9 +192,7 @@ Polyline2d across(const RoadSpec& road, double s, double from, double to) {
     const double length = polyline_length(road.centreline);
     s -= length * std::floor(s / length);
   }
-  const PolylineSample at = sample_polyline(road.centreline, s);
-  const Eigen::Vector2d left(-at.tangent.y(), at.tangent.x());
-  return {at.point + left * from, at.point + left * to};
+  return {beside(road, s, from), beside(road, s, to)};
 }
 
 // Lateral extent of the carriageway's half that traffic in a direction uses.

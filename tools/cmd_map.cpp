@@ -90,9 +90,9 @@ void print_export(const AutowareExportSummary& e) {
   std::cout << "autoware     " << e.dir << "/{" << kAutowarePointCloudFile << ", " << kAutowareLanelet2File << ", "
             << kAutowareProjectorFile << "}\n"
             << "  points     " << e.points << "\n"
-            << "  lanelet2   road lanelets " << l.road_lanelets << ", curbstones " << l.curbstones << ", crosswalks "
-            << l.crosswalks << ", stop lines " << l.stop_lines << " + " << l.derived_stop_lines
-            << " derived before crosswalks, nodes " << l.nodes << "\n";
+            << "  lanelet2   road lanelets " << l.road_lanelets << " (" << l.intersection_lanelets
+            << " in junctions), curbstones " << l.curbstones << ", crosswalks " << l.crosswalks << ", stop lines "
+            << l.stop_lines << " + " << l.derived_stop_lines << " derived before crosswalks, nodes " << l.nodes << "\n";
 }
 
 int run_map(const Args& args) {
