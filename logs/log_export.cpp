@@ -10,12 +10,12 @@
 #include <fstream>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <vector>
 
 #include "common/input_error.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
+#include "logs/pcd_file.hpp"
 #include "logs/ros2_messages.hpp"
 #include "logs/tum_file.hpp"
 
@@ -105,11 +105,9 @@ ExportResult export_pcd(const std::string& log, const std::string& dir, const st
   for (McapMessage m; reader.next(m);) {
     if (m.channel->topic != chosen || !has_type(m, "sensor_msgs/msg/PointCloud2")) continue;
     const PointCloud cloud = ros2::decode_point_cloud(m.data, context(reader, m));
-    std::ostringstream head;
-    head << "# .PCD v0.7 - lidarloop scan, stamp " << cloud.stamp_ns << " ns\n"
-         << "VERSION 0.7\nFIELDS x y z intensity ring time\nSIZE 4 4 4 4 2 4\nTYPE F F F F U F\nCOUNT 1 1 1 1 1 1\n"
-         << "WIDTH " << cloud.points.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << cloud.points.size()
-         << "\nDATA binary\n";
+    const std::string h =
+        binary_pcd_header({{"x"}, {"y"}, {"z"}, {"intensity"}, {"ring", 2, 'U'}, {"time"}}, cloud.points.size(),
+                          "lidarloop scan, stamp " + std::to_string(cloud.stamp_ns) + " ns");
     body.clear();
     body.reserve(cloud.points.size() * 22);
     for (const LidarPoint& p : cloud.points) {
@@ -120,7 +118,6 @@ ExportResult export_pcd(const std::string& log, const std::string& dir, const st
     }
     const std::string path = numbered(dir, count, 6, ".pcd");
     std::ofstream out = open_out(path);
-    const std::string h = head.str();
     out.write(h.data(), std::streamsize(h.size()));
     out.write(body.data(), std::streamsize(body.size()));
     if (!out.flush()) throw InputError(path + ": write failed");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include "common/units.hpp"
 #include "common/yaml_reader.hpp"
 #include "localizer/hd_map.hpp"
+#include "loop/autoware_export.hpp"
 #include "loop/map_cache.hpp"
 #include "sim/path.hpp"
 #include "sim/world_assets.hpp"
@@ -69,9 +71,34 @@ void print_survey(const std::string& world, const MappingOptions& o, const std::
             << "survey plot  " << map_dir << "/survey_error.png\n";
 }
 
+// `--export FORMAT DIR`: the formats other programs load a map in. Checked before the map is built, so
+// a mistake costs no mapping drive.
+std::optional<std::string> export_dir(const Args& args) {
+  const auto format = args.value("export");
+  const bool has_dir = args.positional().size() > 1;
+  if (!format && has_dir) throw InputError("a second argument (a folder) goes with --export FORMAT");
+  if (!format) return std::nullopt;
+  if (*format != "autoware") throw InputError("--export: unknown format '" + *format + "' (known: autoware)");
+  if (!has_dir)
+    throw InputError("--export " + *format + " needs a folder: lidarloop map WORLD --export " + *format + " DIR");
+  make_export_folder(args.positional().at(1));
+  return args.positional().at(1);
+}
+
+void print_export(const AutowareExportSummary& e) {
+  const Lanelet2Summary& l = e.lanelet2;
+  std::cout << "autoware     " << e.dir << "/{" << kAutowarePointCloudFile << ", " << kAutowareLanelet2File << ", "
+            << kAutowareProjectorFile << "}\n"
+            << "  points     " << e.points << "\n"
+            << "  lanelet2   road lanelets " << l.road_lanelets << " (" << l.intersection_lanelets
+            << " in junctions), curbstones " << l.curbstones << ", crosswalks " << l.crosswalks << ", stop lines "
+            << l.stop_lines << " + " << l.derived_stop_lines << " derived before crosswalks, nodes " << l.nodes << "\n";
+}
+
 int run_map(const Args& args) {
   const auto limit = limit_threads(thread_count(args));
   const MappingOptions options = mapping_options(args);
+  const std::optional<std::string> out = export_dir(args);
   const MapLocation loc = ensure_map(args.positional().at(0), options, args.flag("force"));
   const IntensityMapHeader h = read_intensity_map_header(loc.dir);
   std::cout << "map          " << loc.dir << (loc.built ? " (built)" : " (found in the cache)") << "\n";
@@ -81,6 +108,11 @@ int run_map(const Args& args) {
             << " m cells; mean.png, variance.png\n"
             << "curbs        " << loc.dir << "/curbs.geojson\n";
   print_survey(args.positional().at(0), options, loc.dir);
+  if (out) {
+    AutowareExportConfig config;
+    config.voxel_m = args.number("export-voxel", config.voxel_m);
+    print_export(export_autoware_map(args.positional().at(0), options, loc.dir, *out, config));
+  }
   return 0;
 }
 
@@ -138,20 +170,24 @@ int bench_map(const Args& args) {
 Command map_command() {
   return {{"map",
            "lidarloop map WORLD [--traffic] [--force] [--resolution M] [--speed V] [--realism PROFILE]\n"
-           "                    [--survey FILE.yaml]",
+           "                    [--survey FILE.yaml] [--export autoware DIR]",
            "Build a world's HD map by a mapping drive over every lane (or find it in the cache): the curb\n"
            "layer (GeoJSON) and the intensity layer (tiles of per-cell count, mean and variance, Eq. 8).\n"
            "The map is a survey: scans placed with an RTK-INS pose error, by another HDL-32E unit, and the\n"
-           "curbs moved by that error; prints the error and writes survey_error.png beside the map.",
+           "curbs moved by that error; prints the error and writes survey_error.png beside the map.\n"
+           "--export autoware DIR writes the map as Autoware loads it: pointcloud_map.pcd, lanelet2_map.osm\n"
+           "(Lanelet2) and map_projector_info.yaml.",
            {{"traffic", "", "oncoming traffic during the drive (raises the variance of the cells it crosses)"},
             {"force", "", "rebuild even if the cache has this map"},
             {"resolution", "M", "intensity cell size (default 0.2 m)"},
             {"speed", "M_S", "mapping drive speed (default 15 m/s)"},
             {"realism", "PROFILE", "the survey of a realism profile: ideal, typical (default) or harsh"},
             {"survey", "FILE", "survey settings in YAML (unit_serial, sigma_xy_m, heading_sigma_deg, ...)"},
-            {"threads", "N", "worker threads (default: all cores)"}},
+            {"threads", "N", "worker threads (default: all cores)"},
+            {"export", "FORMAT", "also write the map for another program into the folder given after it: autoware"},
+            {"export-voxel", "M", "voxel of the exported point cloud (default 0.4 m, the point layer's; not finer)"}},
            1,
-           1},
+           2},
           run_map};
 }
 
