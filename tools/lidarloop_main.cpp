@@ -1,5 +1,7 @@
 // lidarloop: the command-line front end. Exit codes: 0 success, 1 a scenario failed its thresholds,
-// 2 bad input or usage.
+// 2 bad input or usage, or an output that cannot be written (a missing or read-only folder, a full
+// disk), 3 an internal error.
+#include <filesystem>
 #include <iostream>
 
 #include "common/input_error.hpp"
@@ -43,6 +45,10 @@ int main(int argc, char** argv) {
       return c.run(args);
     } catch (const InputError& e) {
       std::cerr << "lidarloop: error: " << e.what() << "\n";
+      return 2;
+    } catch (const std::filesystem::filesystem_error& e) {
+      // A folder or file the command was told to use and cannot: the user's to fix, like bad input.
+      std::cerr << "lidarloop: error: " << e.path1().string() << ": " << e.code().message() << "\n";
       return 2;
     } catch (const std::exception& e) {
       std::cerr << "lidarloop: internal error: " << e.what() << "\n";
