@@ -2,65 +2,69 @@
 # A recording killed with SIGKILL loses at most the last second of log time. Records a complete run of
 # a scenario, then the same run (same seed: the same messages) killed at ten moments drawn from fixed
 # seeds, recovers each killed log with `lidarloop recover`, and compares: the recovered messages must
-# be the complete log's first ones, and every message the killed run had written but recover did not
-# get back must lie within 1 s of log time of the newest one it had written.
+# be the complete log's first ones, and every message the killed run had already written but recover
+# did not get back must lie within 1 s of log time of the newest one it had written.
 #
-# How far a killed run got: `simulate` prints its simulated time on a terminal after every step, so it
-# runs on a pseudo-terminal (script(1)) and the last time printed, plus its rounding, bounds the
-# newest message written from above: the loss figures are upper bounds.
+# How far a killed run got: `simulate --scan-every 1` writes each scan to a PLY file of its own the
+# moment the scan is complete (before the recorder gets it). With k PLY files on disk the run had not
+# completed scan k: nothing it wrote is newer than scan k's end, the stamp of scan k (read from the
+# complete run's PLY) plus one scan period plus a margin for the sensor clocks. So the loss measured
+# is an upper bound, by up to one scan period.
 #
 # kill_recording.sh LIDARLOOP MCAP_LOG_TIMES SCENARIO WORKDIR [KILLS] [DURATION_S]
 set -euo pipefail
 lidarloop=$1 log_times=$2 scenario=$3 work=$4 kills=${5:-10} duration=${6:-3}
 max_loss_ns=1000000000
-# %.1f s on the progress line: the time printed is at most 0.05 s behind, plus one step of 1 ms.
-progress_slack_ns=51000000
+clock_margin_ns=20000000  # the LiDAR's and CAN's clocks run a few ms off the simulation's
 
 rm -rf "$work"
 mkdir -p "$work"
-simulate=("$lidarloop" simulate "$scenario" --duration "$duration" --scan-every 0)
+simulate=("$lidarloop" simulate "$scenario" --duration "$duration" --scan-every 1)
+scan_stamp() { grep -a -m1 '^comment stamp_ns ' "$1" | cut -d' ' -f3; }
 
-start=$(date +%s%N)
-"${simulate[@]}" --record "$work/complete.mcap" --out "$work/complete" > /dev/null
-wall_ns=$(($(date +%s%N) - start))
-"$log_times" "$work/complete.mcap" > "$work/complete.txt"
-echo "complete run: $(wc -l < "$work/complete.txt") messages, ${duration} s of log in $((wall_ns / 1000000)) ms"
+"${simulate[@]}" --record "$work/complete.mcap" --out "$work/complete" > "$work/complete.txt"
+sim_wall_ms=$(awk '/^simulated/ { printf "%d", $5 * 1000 }' "$work/complete.txt")
+"$log_times" "$work/complete.mcap" > "$work/complete_times.txt"
+scans=$(ls "$work/complete/scans" | wc -l)
+period_ns=$(($(scan_stamp "$work/complete/scans/scan_000001.ply") - $(scan_stamp "$work/complete/scans/scan_000000.ply")))
+echo "complete run: $(wc -l < "$work/complete_times.txt") messages, $scans scans, ${duration} s of log simulated in ${sim_wall_ms} ms"
 
 worst_ns=0 worst_messages=0
 for seed in $(seq 1 "$kills"); do
   RANDOM=$seed
-  delay_ns=$((wall_ns * (20 + 75 * RANDOM / 32767) / 100))  # 20-95 % of the complete run's wall time
-  rm -rf "$work/killed.mcap" "$work/killed" "$work/pid" "$work/recovered.mcap"
-  script -qfec "echo \$\$ > '$work/pid'; exec ${simulate[*]} --record '$work/killed.mcap' --out '$work/killed'" \
-    /dev/null < /dev/null > "$work/progress.txt" &
-  script_pid=$!
-  sleep "$(awk -v ns="$delay_ns" 'BEGIN { printf "%.3f", ns / 1e9 }')"
+  delay_ms=$((sim_wall_ms * (5 + 90 * RANDOM / 32767) / 100))  # 5-95 % into the simulation
+  rm -rf "$work/killed.mcap" "$work/killed" "$work/recovered.mcap"
+  "${simulate[@]}" --record "$work/killed.mcap" --out "$work/killed" > /dev/null &
+  pid=$!
+  until [ -e "$work/killed/scans/scan_000000.ply" ] || ! kill -0 "$pid" 2> /dev/null; do sleep 0.01; done
+  sleep "$(awk -v ms="$delay_ms" 'BEGIN { printf "%.3f", ms / 1000 }')"
   killed=yes
-  kill -KILL "$(cat "$work/pid")" 2> /dev/null || killed="no (it had finished)"
-  wait "$script_pid" || true
+  kill -KILL "$pid" 2> /dev/null || killed="no, it had finished"
+  wait "$pid" 2> /dev/null || true
 
-  newest=$(grep -ao '[0-9.]* of [0-9.]* s' "$work/progress.txt" | tail -1 | cut -d' ' -f1)
-  [ -n "$newest" ] || newest=0
-  newest_ns=$(awk -v s="$newest" -v slack="$progress_slack_ns" 'BEGIN { printf "%d", s * 1e9 + slack }')
-  recovered=0
-  if [ -e "$work/killed.mcap" ]; then
-    "$lidarloop" recover "$work/killed.mcap" "$work/recovered.mcap" > /dev/null
-    "$log_times" "$work/recovered.mcap" > "$work/recovered.txt"
-    recovered=$(wc -l < "$work/recovered.txt")
-    if ! cmp -s "$work/recovered.txt" <(head -n "$recovered" "$work/complete.txt"); then
-      echo "kill $seed: the recovered messages are not the complete log's first $recovered" >&2
-      exit 1
-    fi
+  done_scans=$(ls "$work/killed/scans" | wc -l)
+  if [ "$done_scans" -ge "$scans" ]; then
+    newest_ns=$(awk -v d="$duration" 'BEGIN { printf "%d", d * 1e9 }')
+  else
+    next=$(printf '%s/complete/scans/scan_%06d.ply' "$work" "$done_scans")
+    newest_ns=$(($(scan_stamp "$next") + period_ns + clock_margin_ns))
   fi
-  # Messages the killed run had written (log time up to the newest) that recover did not get back.
+  "$lidarloop" recover "$work/killed.mcap" "$work/recovered.mcap" > /dev/null
+  "$log_times" "$work/recovered.mcap" > "$work/recovered_times.txt"
+  recovered=$(wc -l < "$work/recovered_times.txt")
+  if ! cmp -s "$work/recovered_times.txt" <(head -n "$recovered" "$work/complete_times.txt"); then
+    echo "kill $seed: the recovered messages are not the complete log's first $recovered" >&2
+    exit 1
+  fi
+  # Messages the killed run may have written (log time up to the newest) that recover did not get back.
   read -r lost loss_ns < <(awk -v from="$recovered" -v newest="$newest_ns" '
     NR > from && $1 <= newest { if (!n++) oldest = $1 }
-    END { printf "%d %d\n", n, n ? newest - oldest : 0 }' "$work/complete.txt")
-  printf 'kill %2d after %5d ms (killed: %s): newest log time <= %.3f s, recovered %d messages, lost %d (%.3f s of log time)\n' \
-    "$seed" $((delay_ns / 1000000)) "$killed" "$(awk -v n="$newest_ns" 'BEGIN { print n / 1e9 }')" "$recovered" \
+    END { printf "%d %d\n", n, n ? newest - oldest : 0 }' "$work/complete_times.txt")
+  printf 'kill %2d, %4d ms into the simulation (killed: %s): %2d scans done, newest log time <= %.3f s; recovered %5d messages, lost %4d (%.3f s of log time)\n' \
+    "$seed" "$delay_ms" "$killed" "$done_scans" "$(awk -v n="$newest_ns" 'BEGIN { print n / 1e9 }')" "$recovered" \
     "$lost" "$(awk -v n="$loss_ns" 'BEGIN { print n / 1e9 }')"
-  [ "$loss_ns" -gt "$worst_ns" ] && worst_ns=$loss_ns
-  [ "$lost" -gt "$worst_messages" ] && worst_messages=$lost
+  if [ "$loss_ns" -gt "$worst_ns" ]; then worst_ns=$loss_ns; fi
+  if [ "$lost" -gt "$worst_messages" ]; then worst_messages=$lost; fi
 done
 printf 'worst loss: %d messages, %.3f s of log time (limit %.3f s)\n' "$worst_messages" \
   "$(awk -v n="$worst_ns" 'BEGIN { print n / 1e9 }')" "$(awk -v n="$max_loss_ns" 'BEGIN { print n / 1e9 }')"
