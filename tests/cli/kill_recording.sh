@@ -32,6 +32,7 @@ echo "complete run: $(wc -l < "$work/complete_times.txt") messages, $scans scans
 worst_ns=0 worst_messages=0
 for seed in $(seq 1 "$kills"); do
   RANDOM=$seed
+  : $RANDOM $RANDOM  # bash's first draws after seeding follow the seed closely: skip them
   delay_ms=$((sim_wall_ms * (5 + 90 * RANDOM / 32767) / 100))  # 5-95 % into the simulation
   rm -rf "$work/killed.mcap" "$work/killed" "$work/recovered.mcap"
   "${simulate[@]}" --record "$work/killed.mcap" --out "$work/killed" > /dev/null &
