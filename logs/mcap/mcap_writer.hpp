@@ -36,12 +36,12 @@ namespace lidarloop {
 
 struct McapWriterOptions {
   std::string profile = "ros2";
-  std::string library;                        // empty: "lidarloop <version>"
-  bool compress = true;                       // zstd chunks; false stores them uncompressed
-  int compression_level = 1;                  // zstd: 1 is 2.3x faster than 3 on scans, for 5 % more bytes
+  std::string library;                      // empty: "lidarloop <version>"
+  bool compress = true;                     // zstd chunks; false stores them uncompressed
+  int compression_level = 1;                // zstd: 1 is 2.3x faster than 3 on scans, for 5 % more bytes
   uint64_t chunk_size = 4u << 20;           // uncompressed bytes that close a chunk
   int64_t chunk_duration_ns = 500'000'000;  // log time a chunk may span: a kill loses at most twice this
-  bool background = true;                     // compress and write on a worker thread (same bytes)
+  bool background = true;                   // compress and write on a worker thread (same bytes)
   // false: every message is a record of its own in the data section, readable the moment it is
   // written (a live stream to another program); no chunks, so no message indexes either.
   bool chunked = true;
