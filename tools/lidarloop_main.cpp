@@ -3,6 +3,7 @@
 // disk), 3 an internal error.
 #include <filesystem>
 #include <iostream>
+#include <string>
 
 #include "common/input_error.hpp"
 #include "tools/commands.hpp"
@@ -48,7 +49,8 @@ int main(int argc, char** argv) {
       return 2;
     } catch (const std::filesystem::filesystem_error& e) {
       // A folder or file the command was told to use and cannot: the user's to fix, like bad input.
-      std::cerr << "lidarloop: error: " << e.path1().string() << ": " << e.code().message() << "\n";
+      const std::string path = e.path1().empty() ? std::string("file system") : e.path1().string();
+      std::cerr << "lidarloop: error: " << path << ": " << e.code().message() << "\n";
       return 2;
     } catch (const std::exception& e) {
       std::cerr << "lidarloop: internal error: " << e.what() << "\n";

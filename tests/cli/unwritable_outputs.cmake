@@ -1,6 +1,6 @@
 # Outputs that cannot be written fail cleanly and early: exit 2 and a single line naming the path,
 # never an internal error, and for `run` before the map is opened (so no map is needed here).
-# -DLIDARLOOP=... -DSCENARIO=... -DWORKDIR=...
+# -DLIDARLOOP=... -DSCENARIO=... -DSWEEP=... -DWORKDIR=...
 file(REMOVE_RECURSE ${WORKDIR})
 file(MAKE_DIRECTORY ${WORKDIR})
 
@@ -38,3 +38,4 @@ expect_clean_failure(/dev/full export ${WORKDIR}/short.mcap --tum /dev/full)
 expect_clean_failure(/proc/nope export ${WORKDIR}/short.mcap --pcd /proc/nope)
 expect_clean_failure(/proc/nope replay ${WORKDIR}/short.mcap --out /proc/nope)
 expect_clean_failure(/dev/full recover ${WORKDIR}/short.mcap /dev/full)
+expect_clean_failure(/proc/nope sweep ${SWEEP} --out /proc/nope)
