@@ -13,8 +13,11 @@ namespace topics = log_topics;
 
 RecordedRun recorded_run(const McapReader& reader, const std::string& log) {
   RecordedRun run;
-  for (const auto& a : reader.attachments())
+  std::optional<std::string> vehicle_text;
+  for (const auto& a : reader.attachments()) {
     if (a.name == kScenarioAttachment) run.scenario_text.assign(a.data.begin(), a.data.end());
+    if (a.name == kVehicleAttachment) vehicle_text.emplace(a.data.begin(), a.data.end());
+  }
   for (const auto& m : reader.metadata())
     if (m.name == kRunMetadata) run.metadata.insert(m.metadata.begin(), m.metadata.end());
   if (run.scenario_text.empty() || run.metadata.empty())
@@ -29,8 +32,17 @@ RecordedRun recorded_run(const McapReader& reader, const std::string& log) {
     realism = parse_realism(run.metadata.at("realism"));
     if (!realism) throw InputError(log + ": metadata " + kRunMetadata + " has an unknown realism profile");
   }
-  run.scenario = parse_scenario(run.scenario_text, run.scenario_name,
-                                load_vehicle_params(data_dir() + "/assets/vehicle.yaml"), realism);
+  // The vehicle the run had, read as strictly as assets/vehicle.yaml; the scenario's ego.vehicle then
+  // sets the same values again.
+  VehicleParams vehicle;
+  if (vehicle_text) {
+    const YamlReader y = YamlReader::from_string(*vehicle_text, log + ": " + kVehicleAttachment);
+    if (!y.root().IsNull()) read_vehicle_params(y, y.root(), vehicle);
+  } else {
+    run.vehicle_from = data_dir() + "/assets/vehicle.yaml";
+    vehicle = load_vehicle_params(*run.vehicle_from);
+  }
+  run.scenario = parse_scenario(run.scenario_text, run.scenario_name, vehicle, realism);
   try {
     run.scenario.seed = std::stoull(run.metadata.at("seed"));
   } catch (const std::exception&) {

@@ -1,8 +1,10 @@
 #pragma once
 // What a log recorded by `run --record` or `simulate --record` says about its run, for the commands
 // that work on a log instead of simulating (`replay`, `score`): the scenario as it ran (the recorded
-// YAML, with the run's realism profile and seed from the metadata), the recorded method, and what
-// happened (the ground truth, the curb visibility, a scan).
+// YAML and vehicle, with the run's realism profile and seed from the metadata), the recorded method,
+// and what happened (the ground truth, the curb visibility, a scan). Of assets/, only the vehicle of a
+// log older than its attachment is read here; the world and its map are too large for a log and are
+// found by name (the metadata's map_hash says which map the run had).
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -22,6 +24,9 @@ struct RecordedRun {
   std::map<std::string, std::string> metadata;
   std::string method;  // the recorded localizer method; empty for `simulate`
   Scenario scenario;   // parsed from scenario_text, with the run's realism profile and seed
+  // Set for a log recorded before the vehicle was (no kVehicleAttachment): the assets file the vehicle
+  // was read from instead, which may differ from the one the run had.
+  std::optional<std::string> vehicle_from;
 };
 
 // The run's scenario and settings, which the recorder writes before the first chunk: call after the

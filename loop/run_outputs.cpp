@@ -1,8 +1,13 @@
 #include "loop/run_outputs.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 
+#include "common/input_error.hpp"
 #include "localizer/driving_corridor.hpp"
 #include "logs/ros2_messages.hpp"
 #include "loop/birdseye.hpp"
@@ -36,6 +41,15 @@ void write_worst_frame(const std::string& path, const WorstFrame& w, const HdMap
 
 }  // namespace
 
+void prepare_output_dir(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError(dir + ": cannot create the output folder (" + ec.message() + ")");
+  // access() sees a read-only file system and missing permissions (though not, for root, a mode).
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw InputError(dir + ": cannot write into the output folder (" + std::strerror(errno) + ")");
+}
+
 std::vector<TruthPose> truth_poses(const std::vector<TruthSample>& truth) {
   std::vector<TruthPose> out;
   out.reserve(truth.size());
@@ -68,7 +82,7 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
   scored.metrics.mount_error_rpy_deg = mount.lidar_rpy_rad * kDegPerRad;
   scored.metrics.mount_error_xyz_m = mount.lidar_xyz_m;
 
-  std::filesystem::create_directories(dir);
+  prepare_output_dir(dir);
   write_metrics_json(dir + "/metrics.json", scored.metrics);
   write_errors_csv(dir + "/errors.csv", scored, estimates);
   write_tum(dir + "/estimate.tum", estimates);

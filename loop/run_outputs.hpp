@@ -10,6 +10,11 @@
 
 namespace lidarloop {
 
+// Creates `dir` (and its parents) for a command's output files and checks that files can be made in
+// it: called before a run, so that an output that cannot be written fails at once, not after the run.
+// InputError naming the folder and the reason otherwise.
+void prepare_output_dir(const std::string& dir);
+
 // The scorer's plain inputs from the loop's records. The truth's stamped poses (the scorer needs no
 // speeds or steering):
 std::vector<TruthPose> truth_poses(const std::vector<TruthSample>& truth);

@@ -1,6 +1,7 @@
 #include "loop/run_recording.hpp"
 
 #include "common/input_error.hpp"
+#include "logs/tum_file.hpp"
 #include "loop/localizer_setup.hpp"
 #include "loop/map_cache.hpp"
 
@@ -12,6 +13,29 @@ std::string join_lines(const std::vector<std::string>& lines) {
   return out;
 }
 }  // namespace
+
+std::string vehicle_yaml(const VehicleParams& v) {
+  const std::pair<const char*, double> numbers[] = {{"cornering_stiffness_front", v.cornering_stiffness_front},
+                                                    {"cornering_stiffness_rear", v.cornering_stiffness_rear},
+                                                    {"lf", v.lf},
+                                                    {"lr", v.lr},
+                                                    {"yaw_inertia", v.yaw_inertia},
+                                                    {"mass", v.mass},
+                                                    {"steering_ratio", v.steering_ratio},
+                                                    {"wheel_radius", v.wheel_radius},
+                                                    {"track_width", v.track_width},
+                                                    {"max_steer", v.max_steer},
+                                                    {"max_steer_rate", v.max_steer_rate},
+                                                    {"steer_time_constant", v.steer_time_constant},
+                                                    {"max_accel", v.max_accel},
+                                                    {"max_decel", v.max_decel},
+                                                    {"accel_time_constant", v.accel_time_constant},
+                                                    {"max_speed", v.max_speed},
+                                                    {"kinematic_below", v.kinematic_below}};
+  std::string out = "# The ego vehicle of the recorded run: assets/vehicle.yaml with the scenario's ego.vehicle.\n";
+  for (const auto& [key, value] : numbers) out += std::string(key) + ": " + round_trip_number(value) + "\n";
+  return out + "step_ns: " + std::to_string(v.step_ns) + "\n";
+}
 
 void RecordingSink::on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) {
   std::vector<ros2::ActorState> states;
@@ -27,6 +51,7 @@ std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>&
   auto recorder = std::make_unique<RecordingSink>(*path, scenario.lidar.mount());
   McapRecorder& log = recorder->log();
   log.add_attachment(kScenarioAttachment, "application/yaml", scenario.text);
+  log.add_attachment(kVehicleAttachment, "application/yaml", vehicle_yaml(scenario.ego.vehicle));
   log.add_metadata(kRunMetadata, {{"scenario", scenario.file},
                                   {"world", scenario.world},
                                   {"seed", std::to_string(scenario.seed)},

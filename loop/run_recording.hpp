@@ -1,6 +1,7 @@
 #pragma once
 // `--record FILE.mcap`: a run's streams as an MCAP log, with what replay needs to redo the run
-// exactly: the scenario YAML as an attachment, and the seed, method and map as metadata.
+// exactly: the scenario YAML and the resolved vehicle as attachments, and the seed, method, realism
+// profile and map as metadata.
 #include <memory>
 #include <optional>
 #include <string>
@@ -13,6 +14,13 @@ namespace lidarloop {
 
 inline constexpr const char* kScenarioAttachment = "scenario.yaml";
 inline constexpr const char* kRunMetadata = "lidarloop.run";
+// The ego vehicle as the run resolved it (assets/vehicle.yaml, then the scenario's ego.vehicle), in
+// assets/vehicle.yaml's format: replay reads it instead of assets/, which may have changed since.
+inline constexpr const char* kVehicleAttachment = "vehicle.yaml";
+
+// Every VehicleParams field as assets/vehicle.yaml writes it, each number exact (read_vehicle_params
+// reads back the same doubles).
+std::string vehicle_yaml(const VehicleParams& vehicle);
 
 // Passes every stream to two sinks (files and a recorder).
 class TeeSink : public StreamSink {

@@ -2,7 +2,9 @@
 // the order they were recorded, and scored against the recorded ground truth. The scenario, seed and
 // method come from the log itself, so the estimates are those of the live run, bit for bit. Replay
 // does not simulate: the curb the traffic hid (metrics.json's curb_hidden_fraction) is read from the
-// log's /truth/curb_visibility, as the live run measured it (null for a log without it).
+// log's /truth/curb_visibility, as the live run measured it (null for a log without it). The vehicle
+// is the log's too (assets/vehicle.yaml may have changed since); the world and its map are found by
+// name, with a note on stderr when the map is not the one the run had.
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -14,6 +16,7 @@
 #include "logs/ros2_messages.hpp"
 #include "loop/localizer_backend.hpp"
 #include "loop/localizer_setup.hpp"
+#include "loop/map_cache.hpp"
 #include "loop/recorded_log.hpp"
 #include "loop/result_files.hpp"
 #include "loop/run_outputs.hpp"
@@ -36,6 +39,18 @@ int run_replay(const Args& args) {
   std::optional<std::string> method = args.value("method");
   if (!method && !recorded_method.empty()) method = recorded_method;
   const LocalizerParams params = localizer_params_for(scenario, method);
+  const std::string name = std::filesystem::path(run.scenario_name).stem().string();
+  const std::string out = args.text("out", "out/" + name + "-replay");
+  prepare_output_dir(out);  // before the replay, not after it
+  if (run.vehicle_from)
+    std::cerr << "lidarloop: note: " << log << " has no " << kVehicleAttachment << " (recorded by an older lidarloop): "
+              << "the vehicle is read from " << *run.vehicle_from << ", which may have changed since\n";
+  const auto recorded_map = run.metadata.find("map_hash");
+  const std::string map_now = map_hash(scenario.world, scenario_mapping_options(scenario));
+  if (recorded_map != run.metadata.end() && recorded_map->second != map_now)
+    std::cerr << "lidarloop: note: the map of world '" << scenario.world << "' is not the one " << log
+              << " was recorded with (hash " << map_now << ", recorded " << recorded_map->second
+              << "): its world, materials or actors changed, and the estimates may differ from the run's\n";
   const LoadedWorld world = load_scenario_world(scenario);
   const ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
   HdMap map = open_scenario_map(scenario, world);
@@ -80,8 +95,6 @@ int run_replay(const Args& args) {
   localizer.finish();
   if (truth.empty()) throw InputError(log + ": no " + std::string(topics::truth_state) + " messages to score against");
 
-  const std::string name = std::filesystem::path(run.scenario_name).stem().string();
-  const std::string out = args.text("out", "out/" + name + "-replay");
   const ScoredRun scored = score_and_write(out, name, scenario, resolved.ego_route, truth, method_label(params),
                                            estimates, nullptr, map, curb_visibility);
   std::cout << comparison_markdown({scored.metrics});

@@ -79,13 +79,14 @@ int run_run(const Args& args) {
   const LocalizerParams params = localizer_params_for(s.scenario, args.value("method"));
   const std::string name = std::filesystem::path(s.scenario.file).stem().string();
   const std::string out = args.text("out", "out/" + name);
-  std::filesystem::create_directories(out);
+  // Every output is opened before the map and the run: one that cannot be written fails at once.
+  prepare_output_dir(out);
+  const std::unique_ptr<RecordingSink> recorder =
+      start_recording(args.value("record"), s.scenario, method_text(params));
 
   HdMap map = open_scenario_map(s.scenario, s.world);
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_label(params), s.scenario.duration_s};
-  const std::unique_ptr<RecordingSink> recorder =
-      start_recording(args.value("record"), s.scenario, method_text(params));
   std::function<void(const LocalizerEstimate&)> record_estimate;
   if (recorder)
     record_estimate = [&](const LocalizerEstimate& e) {
@@ -164,7 +165,7 @@ std::vector<Metrics> compare_once(const LoadedScenario& s, const std::vector<std
   std::vector<LocalizerParams> params;
   for (const auto& m : methods) params.push_back(localizer_params_for(s.scenario, m));
   const std::string name = std::filesystem::path(s.scenario.file).stem().string();
-  std::filesystem::create_directories(out);
+  prepare_output_dir(out);
   HdMap map = open_scenario_map(s.scenario, s.world);
   // Open loop: every method sees the same drive; in closed loop each would drive its own.
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
@@ -202,6 +203,7 @@ int run_compare(const Args& args) {
   }
   const std::string name = std::filesystem::path(s.scenario.file).stem().string();
   const std::string out = args.text("out", "out/" + name + "-compare");
+  prepare_output_dir(out);
   const auto expect = args.value("expect-best");
 
   if (!args.value("seeds")) {

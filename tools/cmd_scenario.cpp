@@ -36,9 +36,10 @@ int run_simulate(const Args& args) {
   const std::string out = args.text("out", "out/" + std::filesystem::path(s.scenario.file).stem().string());
   const int scan_every = int(args.integer("scan-every", s.scenario.scan_every, 0, 1000000));
 
-  Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
+  // The outputs first: one that cannot be written fails before the simulation is built.
   CsvStreams streams(out, LocalFrame(s.world.description.origin), scan_every);
   const std::unique_ptr<RecordingSink> recorder = start_recording(args.value("record"), s.scenario, "");
+  Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   TeeSink sink(streams, recorder.get());
   const bool terminal = isatty(STDOUT_FILENO);
   const auto t0 = std::chrono::steady_clock::now();
@@ -49,6 +50,7 @@ int run_simulate(const Args& args) {
     std::fflush(stdout);
   });
   if (recorder) recorder->log().close();
+  streams.finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (terminal) std::printf("\r%60s\r", "");
 

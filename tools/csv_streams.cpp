@@ -1,6 +1,8 @@
 #include "tools/csv_streams.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 
 #include "tools/ply_file.hpp"
@@ -25,16 +27,30 @@ CsvStreams::CsvStreams(const std::string& dir, const LocalFrame& frame, int scan
 
 std::ofstream CsvStreams::open(const std::string& name, const std::string& header) {
   std::ofstream out(dir_ + "/" + name);
-  if (!out) throw InputError(dir_ + "/" + name + ": cannot write file");
+  if (!out) throw InputError(dir_ + "/" + name + ": cannot write file (" + std::strerror(errno) + ")");
   out.precision(10);
   out << header << '\n';
   return out;
+}
+
+void CsvStreams::check(const std::ofstream& out, const char* name) const {
+  if (!out) throw InputError(dir_ + "/" + name + ": write failed (" + std::strerror(errno) + ")");
+}
+
+void CsvStreams::finish() {
+  const std::pair<std::ofstream*, const char*> files[] = {
+      {&truth_, "truth.csv"}, {&can_, "can.csv"}, {&gps_, "gps.csv"}, {&rtk_, "rtk.csv"}, {&actors_, "actors.csv"}};
+  for (const auto& [out, name] : files) {
+    out->close();
+    check(*out, name);
+  }
 }
 
 void CsvStreams::on_truth(const TruthSample& s) {
   truth_ << s.stamp_ns << ',' << s.pose.x << ',' << s.pose.y << ',' << s.pose.yaw << ',' << s.speed << ',' << s.yaw_rate
          << ',' << s.steer << ',' << s.cross_track << ',' << s.body.heave << ',' << s.body.pitch << ',' << s.body.roll
          << '\n';
+  check(truth_, "truth.csv");
   if (ego_path_.empty() || (ego_path_.back() - Eigen::Vector2d(s.pose.x, s.pose.y)).norm() > 0.5)
     ego_path_.emplace_back(s.pose.x, s.pose.y);
   cross_track_sq_ += s.cross_track * s.cross_track;
@@ -45,6 +61,7 @@ void CsvStreams::on_can(const CanFrame& f) {
   can_ << f.stamp_ns;
   for (double w : f.wheel_speed_mps) can_ << ',' << w;
   can_ << ',' << f.steering_wheel_angle_rad << '\n';
+  check(can_, "can.csv");
 }
 
 void CsvStreams::write_fix(std::ofstream& out, const GpsFix& f) {
@@ -61,8 +78,14 @@ void CsvStreams::write_fix(std::ofstream& out, const GpsFix& f) {
       << ',' << f.heading_variance << ',' << xy.x() << ',' << xy.y() << '\n';
 }
 
-void CsvStreams::on_gps(const GpsFix& f) { write_fix(gps_, f); }
-void CsvStreams::on_rtk(const GpsFix& f) { write_fix(rtk_, f); }
+void CsvStreams::on_gps(const GpsFix& f) {
+  write_fix(gps_, f);
+  check(gps_, "gps.csv");
+}
+void CsvStreams::on_rtk(const GpsFix& f) {
+  write_fix(rtk_, f);
+  check(rtk_, "rtk.csv");
+}
 
 void CsvStreams::on_scan(const PointCloud& cloud, const Eigen::Isometry3d&) {
   if (scan_every_ > 0 && scans_ % size_t(scan_every_) == 0) {
@@ -77,6 +100,7 @@ void CsvStreams::on_actors(int64_t stamp_ns, const std::vector<ActorSample>& act
   for (const auto& a : actors) {
     actors_ << stamp_ns << ',' << a.name << ',' << actor_type_name(a.type) << ',' << a.pose.x << ',' << a.pose.y << ','
             << a.pose.yaw << '\n';
+    check(actors_, "actors.csv");
     Polyline2d& path = actor_paths_[a.name];
     if (path.empty() || (path.back() - Eigen::Vector2d(a.pose.x, a.pose.y)).norm() > 0.5)
       path.emplace_back(a.pose.x, a.pose.y);

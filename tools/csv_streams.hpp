@@ -20,6 +20,10 @@ class CsvStreams : public StreamSink {
   void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override;
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override;
 
+  // Flushes and closes the files; InputError naming a file that could not be written (a full disk).
+  // A write that fails during the run throws at the next sample of its stream.
+  void finish();
+
   const Polyline2d& ego_path() const { return ego_path_; }
   const std::map<std::string, Polyline2d>& actor_paths() const { return actor_paths_; }
   size_t scans() const { return scans_; }
@@ -27,6 +31,7 @@ class CsvStreams : public StreamSink {
 
  private:
   std::ofstream open(const std::string& name, const std::string& header);
+  void check(const std::ofstream& out, const char* name) const;
   void write_fix(std::ofstream& out, const GpsFix& f);
 
   std::string dir_;

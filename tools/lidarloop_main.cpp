@@ -1,6 +1,9 @@
 // lidarloop: the command-line front end. Exit codes: 0 success, 1 a scenario failed its thresholds,
-// 2 bad input or usage.
+// 2 bad input or usage, or an output that cannot be written (a missing or read-only folder, a full
+// disk), 3 an internal error.
+#include <filesystem>
 #include <iostream>
+#include <string>
 
 #include "common/input_error.hpp"
 #include "tools/commands.hpp"
@@ -43,6 +46,11 @@ int main(int argc, char** argv) {
       return c.run(args);
     } catch (const InputError& e) {
       std::cerr << "lidarloop: error: " << e.what() << "\n";
+      return 2;
+    } catch (const std::filesystem::filesystem_error& e) {
+      // A folder or file the command was told to use and cannot: the user's to fix, like bad input.
+      const std::string path = e.path1().empty() ? std::string("file system") : e.path1().string();
+      std::cerr << "lidarloop: error: " << path << ": " << e.code().message() << "\n";
       return 2;
     } catch (const std::exception& e) {
       std::cerr << "lidarloop: internal error: " << e.what() << "\n";

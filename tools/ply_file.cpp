@@ -38,6 +38,7 @@ void write_ply(const std::string& path, const PointCloud& cloud) {
     p += kRecordSize;
   }
   out.write(buffer.data(), std::streamsize(buffer.size()));
+  out.close();
   if (!out) throw InputError(path + ": write failed");
 }
 

@@ -10,8 +10,10 @@
 namespace lidarloop {
 
 namespace {
-constexpr size_t kMaxQueuedChunks = 2;
-}
+// One closed chunk at a time: it is compressed and written while the caller fills the next, and the
+// caller waits before queueing another, so a chunk is on disk before a newer one is queued.
+constexpr size_t kMaxQueuedChunks = 1;
+}  // namespace
 
 McapOutput::McapOutput(const std::string& path, bool background, bool compress, int compression_level)
     : path_(path), background_(background), compress_(compress), compressor_(compression_level) {
@@ -90,6 +92,13 @@ void McapOutput::run() {
     if (job.chunk) --queued_chunks_;
     changed_.notify_all();
   }
+}
+
+void McapOutput::wait_for_chunks() {
+  if (!background_) return;
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [&] { return queued_chunks_ == 0 || error_; });
+  rethrow();
 }
 
 void McapOutput::drain() {

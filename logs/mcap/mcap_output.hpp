@@ -56,9 +56,12 @@ class McapOutput {
   // complete with the record's offset and length.
   void write(std::vector<uint8_t> bytes, std::optional<mcap::AttachmentIndex> attachment = {},
              std::optional<mcap::MetadataIndex> metadata = {});
-  // Queue a closed chunk: compressed, written with its message indexes, flushed to disk. Blocks while
-  // two chunks are already waiting, which bounds memory when the disk or zstd cannot keep up.
+  // Queue a closed chunk: compressed, written with its message indexes, flushed to the operating
+  // system. Blocks while the previous chunk is still being written: at most one closed chunk is ever
+  // held in memory, which bounds both memory and what a killed process loses.
   void write(ClosedChunk chunk);
+  // Waits until every queued chunk is written and flushed; rethrows the worker's first error.
+  void wait_for_chunks();
   // A buffer a written chunk no longer needs (empty if none), to fill the next chunk without
   // allocating again.
   std::vector<uint8_t> spare_buffer();

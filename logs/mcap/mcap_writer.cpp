@@ -30,6 +30,7 @@ void McapWriter::start() {
   for (uint8_t b : mcap::kMagic) start.u8(b);
   mcap::append(start, mcap::Header{options_.profile, options_.library});
   emit(start);
+  output_->flush();  // a file that cannot be written (a full disk) fails here, before any message
 }
 
 McapWriter::~McapWriter() {
@@ -88,6 +89,11 @@ void McapWriter::write_message(uint16_t channel_id, uint32_t sequence, uint64_t 
   if (channel_id == 0 || channel_id > channels_.size()) throw std::invalid_argument("McapWriter: unknown channel id");
   if (options_.chunked) {
     const auto duration = uint64_t(options_.chunk_duration_ns);
+    // The closed chunk still in memory may not hold messages older than 2 x duration: wait for it.
+    if (queued_chunk_start_ && log_time >= *queued_chunk_start_ + 2 * duration) {
+      output_->wait_for_chunks();
+      queued_chunk_start_.reset();
+    }
     if (!chunk_index_entries_.empty() &&
         std::max(chunk_end_time_, log_time) - std::min(chunk_start_time_, log_time) >= duration)
       flush_chunk();
@@ -126,6 +132,7 @@ void McapWriter::flush_chunk() {
   chunk_records_.buffer().clear();
   chunk_index_entries_.clear();
   ++statistics_.chunk_count;
+  queued_chunk_start_ = chunk.start_time;
   output_->write(std::move(chunk));
 }
 

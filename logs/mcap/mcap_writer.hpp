@@ -5,9 +5,16 @@
 // and metadata indexes), summary offsets and a footer with the summary's CRC.
 //
 // A chunk is closed when its uncompressed records reach `chunk_size` bytes or its messages span
-// `chunk_duration_ns` of log time, and the file is flushed after every chunk: a process killed
-// mid-run leaves every closed chunk on disk, readable by `lidarloop recover`, and loses at most
-// about `chunk_duration_ns` of messages (plus a closed chunk still being compressed).
+// `chunk_duration_ns` of log time, and the file is flushed after every chunk. A process killed
+// mid-run (SIGKILL, a crash) leaves every written chunk in the file, readable by `lidarloop
+// recover`, and loses only what was still in memory: the open chunk and at most one closed chunk
+// being compressed and written. Both are bounded in log time (the writer's clock, not the wall's:
+// a simulation runs faster than real time): the open chunk spans less than chunk_duration_ns, and a
+// message stamped 2 x chunk_duration_ns after the start of a closed chunk that is still being
+// written waits until it is. So the messages a kill loses all lie within 2 x chunk_duration_ns
+// (1 s by default) of log time before the newest message written. "Written" means handed to the
+// operating system (fflush): a killed process loses nothing the kernel has; a power cut is another
+// matter (no fsync, which would cost a disk round trip per chunk).
 //
 // Compression, CRCs and file writes happen on a worker thread (McapOutput), so the caller pays only
 // for serialising its messages. The output depends only on what is written (no clocks, no
@@ -16,6 +23,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -28,12 +36,12 @@ namespace lidarloop {
 
 struct McapWriterOptions {
   std::string profile = "ros2";
-  std::string library;                        // empty: "lidarloop <version>"
-  bool compress = true;                       // zstd chunks; false stores them uncompressed
-  int compression_level = 1;                  // zstd: 1 is 2.3x faster than 3 on scans, for 5 % more bytes
-  uint64_t chunk_size = 4u << 20;             // uncompressed bytes that close a chunk
-  int64_t chunk_duration_ns = 1'000'000'000;  // log time a chunk may span
-  bool background = true;                     // compress and write on a worker thread (same bytes)
+  std::string library;                      // empty: "lidarloop <version>"
+  bool compress = true;                     // zstd chunks; false stores them uncompressed
+  int compression_level = 1;                // zstd: 1 is 2.3x faster than 3 on scans, for 5 % more bytes
+  uint64_t chunk_size = 4u << 20;           // uncompressed bytes that close a chunk
+  int64_t chunk_duration_ns = 500'000'000;  // log time a chunk may span: a kill loses at most twice this
+  bool background = true;                   // compress and write on a worker thread (same bytes)
   // false: every message is a record of its own in the data section, readable the moment it is
   // written (a live stream to another program); no chunks, so no message indexes either.
   bool chunked = true;
@@ -102,6 +110,8 @@ class McapWriter {
   ByteWriter chunk_records_;
   std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> chunk_index_entries_;
   uint64_t chunk_start_time_ = 0, chunk_end_time_ = 0;
+  // The start of the last closed chunk, until it is known to be written.
+  std::optional<uint64_t> queued_chunk_start_;
 
   mcap::Statistics statistics_;
   McapWriterStats stats_;

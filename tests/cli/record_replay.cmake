@@ -1,7 +1,10 @@
 # Record a run at one thread and at two: the logs must be byte-identical. Replay the log: the estimates
 # and ground truth must be the live run's exactly, and so must every accuracy figure of metrics.json
 # (latency is wall time and is not compared), the curb occlusion included (replay reads it from the log).
-# -DLIDARLOOP=... -DSCENARIO=... -DWORKDIR=... [-DMETHOD=...: the run's method, recorded in the log]
+# With -DDATA=<source tree>: replay it once more with a copy of the data folder ($LIDARLOOP_DATA) whose
+# assets/vehicle.yaml changed (wheelbase and steering ratio, which the localizer's motion model uses):
+# the log carries the run's vehicle, so the estimates must still be the live run's.
+# -DLIDARLOOP=... -DSCENARIO=... -DWORKDIR=... [-DMETHOD=...: the run's method, recorded in the log] [-DDATA=...]
 file(REMOVE_RECURSE ${WORKDIR})
 file(MAKE_DIRECTORY ${WORKDIR})
 set(method)
@@ -21,18 +24,23 @@ execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORKDIR}/run_1.mcap 
 if(differ)
   message(FATAL_ERROR "the logs recorded at 1 and 2 threads differ")
 endif()
-execute_process(COMMAND ${LIDARLOOP} replay ${WORKDIR}/run_1.mcap --out ${WORKDIR}/replay
-                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "replay exited ${code}\n${out}\n${err}")
-endif()
-foreach(file estimate.tum truth.tum)
-  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORKDIR}/live_1/${file} ${WORKDIR}/replay/${file}
-                  RESULT_VARIABLE differ)
-  if(differ)
-    message(FATAL_ERROR "replay's ${file} differs from the live run's")
+# replay_as_live(DIR WHAT ENV...): replays run_1.mcap into DIR (with the environment ENV) and checks
+# that its estimates and truth are the live run's, byte for byte, and that it needed no note.
+function(replay_as_live dir what)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env ${ARGN} ${LIDARLOOP} replay ${WORKDIR}/run_1.mcap --out ${dir}
+                  RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT code EQUAL 0 OR err MATCHES "note:")
+    message(FATAL_ERROR "${what}: replay exited ${code}\n${out}\n${err}")
   endif()
-endforeach()
+  foreach(file estimate.tum truth.tum)
+    execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORKDIR}/live_1/${file} ${dir}/${file}
+                    RESULT_VARIABLE differ)
+    if(differ)
+      message(FATAL_ERROR "${what}: replay's ${file} differs from the live run's")
+    endif()
+  endforeach()
+endfunction()
+replay_as_live(${WORKDIR}/replay "replay")
 file(READ ${WORKDIR}/live_1/metrics.json live)
 file(READ ${WORKDIR}/replay/metrics.json replay)
 foreach(key frames lateral_rmse_m longitudinal_rmse_m heading_rmse_deg max_position_error_m curb_hidden_fraction
@@ -44,3 +52,17 @@ foreach(key frames lateral_rmse_m longitudinal_rmse_m heading_rmse_deg max_posit
   endif()
 endforeach()
 message(STATUS "1 and 2 threads: identical logs; replay: identical estimates, truth and metrics")
+if(DATA)
+  file(COPY ${DATA}/assets ${DATA}/maps DESTINATION ${WORKDIR}/data)
+  set(vehicle ${WORKDIR}/data/assets/vehicle.yaml)
+  file(READ ${vehicle} text)
+  string(REGEX REPLACE "\nlf: [0-9.]+" "\nlf: 1.5" edited "${text}")
+  string(REGEX REPLACE "\nsteering_ratio: [0-9.]+" "\nsteering_ratio: 14.0" edited "${edited}")
+  if(NOT edited MATCHES "\nlf: 1.5 " OR NOT edited MATCHES "\nsteering_ratio: 14.0 ")
+    message(FATAL_ERROR "could not edit ${vehicle}")
+  endif()
+  file(WRITE ${vehicle} "${edited}")
+  replay_as_live(${WORKDIR}/replay_changed_assets "with assets/vehicle.yaml changed (lf 1.5, steering_ratio 14)"
+                 LIDARLOOP_DATA=${WORKDIR}/data)
+  message(STATUS "assets/vehicle.yaml changed: replay still gives the live run's estimates")
+endif()
