@@ -5,6 +5,7 @@ set -euo pipefail
 
 packages=(
   cmake g++ ninja-build ccache pkg-config clang-format
+  clang libclang-rt-14-dev  # the sanitizer build and its libFuzzer targets (fuzz/)
   libembree-dev libeigen3-dev libgeographiclib-dev libnanoflann-dev libyaml-cpp-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -43,16 +43,23 @@ fi
 build build -DCMAKE_BUILD_TYPE=Release -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=OFF
 expect_tests build unit cli scenario map node sweep external
 ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs"
-# The unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer: only what they run is built,
-# at -O1 with line tables only (-g1: file and line in the sanitizers' stack traces), to keep
-# the instrumented build, which CI runs on two cores, short.
-configure build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
-  -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=ON
-cmake --build build-sanitize -j "$jobs" --target unit_tests
-expect_tests build-sanitize unit
+# The unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer, and the libFuzzer targets
+# (fuzz/) in the same instrumented build, by clang: only what they run is built, at -O1 with line tables
+# only (-g1: file and line in the sanitizers' stack traces), to keep the instrumented build, which CI
+# runs on two cores, short. A folder configured by another compiler is started afresh.
+if [ -f build-sanitize/CMakeCache.txt ] && ! grep -q '^CMAKE_CXX_COMPILER:[A-Z]*=.*clang++' build-sanitize/CMakeCache.txt; then
+  rm -rf build-sanitize
+fi
+configure build-sanitize -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
+  -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=ON -DLIDARLOOP_FUZZ=ON -DLIDARLOOP_BUILD_BENCHMARKS=OFF
+cmake --build build-sanitize -j "$jobs" --target unit_tests fuzz_targets
+expect_tests build-sanitize unit fuzz
 # Three tests that drive the mapping drive over a whole test world (50-120 s each instrumented) run
 # in the pass above only; the same code runs instrumented here in WorldChanges.ACarParkedOnly..., which
 # surveys a 40 m road twice.
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j "$jobs" -L unit \
   -E '^(MappingDrive\.PlacesItsScansWithTheSurveyedPoses|MappingDrive\.SameSeedSameMapBytesOtherSeedOtherMap|IntensityLayer\.TrafficRaisesTheVarianceOfTheCellsItCrosses)$'
+# Every reader of outside files fuzzed for a bounded time (LIDARLOOP_FUZZ_SECONDS each): a crash, a hang,
+# a sanitizer report or an exception other than the reader's InputError fails.
+ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j "$jobs" -L fuzz

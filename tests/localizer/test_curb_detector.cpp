@@ -371,9 +371,10 @@ std::vector<EdgeCase> edge_cases() {
   // max_flat_roughness in exact arithmetic. The fast detector's roughness pre-test must not reject
   // what the median test lets through, rounding included.
   const double bump = defaults.max_flat_roughness * std::sqrt(23.0 / 6.0);
-  for (const auto& [name, scale, feet] : {std::tuple{"just smoother than", 1.0 - 1e-12, 1},
-                                          {"as rough as", 1.0, -1},
-                                          {"just rougher than", 1.0 + 1e-12, 0}}) {
+  for (const auto& [name, scale_param, feet] : {std::tuple{"just smoother than", 1.0 - 1e-12, 1},
+                                                {"as rough as", 1.0, -1},
+                                                {"just rougher than", 1.0 + 1e-12, 0}}) {
+    const double scale = scale_param;  // a lambda may not capture a structured binding before clang 16
     add(std::string("a road ") + name + " allowed",
         ring_of(63, 8.0, [=](size_t k) { return (k < 23 ? 0.0 : 0.15) + (k % 4 == 1 ? bump * scale : 0.0); }), feet);
   }

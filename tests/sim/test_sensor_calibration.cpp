@@ -126,8 +126,9 @@ mount_error: {lidar_rotation_deg: [0, 0, 5.0]}
   ASSERT_FALSE(rec.sensor.empty());
   for (const auto& [stamp, pose] : rec.sensor) {
     // The truth at the stamp (ideal clocks: the stamp is the reference time, on a 10 ms truth sample).
+    const int64_t t = stamp;  // a lambda may not capture a structured binding before clang 16
     const auto it =
-        std::find_if(rec.truth.begin(), rec.truth.end(), [&](const TruthSample& s) { return s.stamp_ns >= stamp; });
+        std::find_if(rec.truth.begin(), rec.truth.end(), [t](const TruthSample& s) { return s.stamp_ns >= t; });
     if (it == rec.truth.end() || it->stamp_ns != stamp) continue;
     const Eigen::Vector3d forward = pose.rotation() * Eigen::Vector3d::UnitX();
     const double sensor_yaw = std::atan2(forward.y(), forward.x());

@@ -77,7 +77,8 @@ struct TurnCase {
 class VehicleSteadyTurn : public ::testing::TestWithParam<TurnCase> {};
 
 TEST_P(VehicleSteadyTurn, RadiusMatchesSingleTrackClosedForm) {
-  const auto [speed, steer] = GetParam();
+  const auto [speed, steer_param] = GetParam();
+  const double steer = steer_param;  // a lambda may not capture a structured binding before clang 16
   const VehicleParams params;
   VehicleModel car(params, VehicleModel::state_at(params, {}, speed));
   constexpr double kSettle = 20, kFitted = 10;  // s: transient (lags, yaw dynamics), then the fitted arc
