@@ -509,4 +509,34 @@ std::vector<ActorState> decode_actor_array(View cdr, const std::string& context,
   return out;
 }
 
+Bytes encode_velodyne_scan(const VelodyneScan& scan) {
+  CdrWriter w;
+  w.reserve(scan.packets.size() * (8 + kVelodynePacketSize + 2));
+  header(w, scan.stamp_ns, scan.frame_id);
+  w.sequence_length(scan.packets.size());
+  for (const auto& p : scan.packets) {
+    const Stamp s = to_stamp(p.stamp_ns);
+    w.i32(s.sec);
+    w.u32(s.nanosec);
+    w.raw(p.data);
+  }
+  return std::move(w.buffer());
+}
+
+VelodyneScan decode_velodyne_scan(View cdr, const std::string& context) {
+  CdrReader r(cdr, context);
+  VelodyneScan scan;
+  scan.stamp_ns = header(r, &scan.frame_id);
+  scan.packets.resize(r.sequence_length(8 + kVelodynePacketSize));
+  for (auto& p : scan.packets) {
+    Stamp s;
+    s.sec = r.i32();
+    s.nanosec = r.u32();
+    p.stamp_ns = from_stamp(s);
+    const View data = r.raw(kVelodynePacketSize);
+    std::copy(data.begin(), data.end(), p.data.begin());
+  }
+  return scan;
+}
+
 }  // namespace lidarloop::ros2

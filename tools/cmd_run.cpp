@@ -85,7 +85,7 @@ int run_run(const Args& args) {
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_label(params), s.scenario.duration_s};
   const std::unique_ptr<RecordingSink> recorder =
-      start_recording(args.value("record"), s.scenario, method_text(params));
+      start_recording(args.value("record"), s.scenario, method_text(params), args.flag("packets"));
   std::function<void(const LocalizerEstimate&)> record_estimate;
   if (recorder)
     record_estimate = [&](const LocalizerEstimate& e) {
@@ -254,7 +254,7 @@ int run_compare(const Args& args) {
 Command run_command() {
   return {{"run",
            "lidarloop run SCENARIO.yaml [--method NAME] [--loop open|closed] [--out DIR] [--seed N]\n"
-           "                    [--record FILE.mcap]",
+           "                    [--record FILE.mcap [--packets]]",
            "Run a scenario with the localizer in the loop and score it against ground truth. Writes\n"
            "metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and plots to DIR. Exit 0 when\n"
            "every threshold of the scenario's `pass` holds, 1 when one fails, 2 on bad input.",
@@ -266,6 +266,7 @@ Command run_command() {
             {"realism", "PROFILE", "ideal, typical or harsh: replaces the scenario's realism profile"},
             {"duration", "S", "override the scenario's duration, seconds"},
             {"record", "FILE.mcap", "record every stream and the estimates as an MCAP log (replay redoes the run)"},
+            {"packets", "", "with --record: also log the HDL-32E's raw UDP packets on /velodyne_packets"},
             {"threads", "N", "worker threads (default: all cores)"}},
            1,
            1},
