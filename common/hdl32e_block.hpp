@@ -51,10 +51,21 @@ inline uint16_t hdl32e_azimuth(double yaw_rad) {
 struct Hdl32ePoint {
   float x, y, z;
 };
-inline Hdl32ePoint hdl32e_point(uint16_t azimuth, double cos_vertical, double sin_vertical, uint16_t distance) {
+// The azimuth's cosine and sine (the drivers' cos_rot_table / sin_rot_table).
+struct Hdl32eRotation2d {
+  double cos, sin;
+};
+inline Hdl32eRotation2d hdl32e_rotation(uint16_t azimuth) {
   const double a = double(azimuth) * kHdl32eAzimuthUnitDeg * M_PI / 180.0;
+  return {std::cos(a), std::sin(a)};
+}
+inline Hdl32ePoint hdl32e_point(Hdl32eRotation2d rotation, double cos_vertical, double sin_vertical,
+                                uint16_t distance) {
   const double d = double(distance) * kHdl32eDistanceUnitM, xy = d * cos_vertical;
-  return {float(xy * std::cos(a)), float(-xy * std::sin(a)), float(d * sin_vertical)};
+  return {float(xy * rotation.cos), float(-xy * rotation.sin), float(d * sin_vertical)};
+}
+inline Hdl32ePoint hdl32e_point(uint16_t azimuth, double cos_vertical, double sin_vertical, uint16_t distance) {
+  return hdl32e_point(hdl32e_rotation(azimuth), cos_vertical, sin_vertical, distance);
 }
 
 }  // namespace lidarloop

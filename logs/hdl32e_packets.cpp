@@ -26,7 +26,9 @@ void put32(uint8_t* p, uint32_t v) {
   for (int i = 0; i < 4; ++i) p[i] = uint8_t(v >> (8 * i));
 }
 uint16_t get16(const uint8_t* p) { return uint16_t(p[0] | p[1] << 8); }
-uint32_t get32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+uint32_t get32(const uint8_t* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
 
 int64_t floor_div(int64_t a, int64_t b) { return a / b - (a % b != 0 && (a < 0) != (b < 0)); }
 
@@ -72,7 +74,8 @@ Hdl32eDataPacket decode_hdl32e_packet(std::span<const uint8_t> bytes, const std:
   if (packet.return_mode != kStrongestReturn && packet.return_mode != kLastReturn)
     fail("return mode " + std::to_string(packet.return_mode) + " is not single return (55 or 56)");
   packet.usec_past_hour = get32(&bytes[kTimestampOffset]);
-  if (packet.usec_past_hour >= kUsPerHour) fail("timestamp " + std::to_string(packet.usec_past_hour) + " us is past the hour");
+  if (packet.usec_past_hour >= kUsPerHour)
+    fail("timestamp " + std::to_string(packet.usec_past_hour) + " us is past the hour");
   for (size_t b = 0; b < packet.blocks.size(); ++b) {
     const uint8_t* p = &bytes[b * kBlockSize];
     if (p[0] != kFlag0 || p[1] != kFlag1) fail("block " + std::to_string(b) + " has no 0xFF 0xEE flag");
@@ -105,7 +108,9 @@ std::vector<ros2::VelodynePacket> hdl32e_data_packets(const Hdl32eRotation& rota
       }
       // Padding after the revolution's last cycle: no returns, the head turning on by the last step.
       const uint16_t last = packet.blocks[k - 1].azimuth;
-      const uint16_t before = k >= 2 ? packet.blocks[k - 2].azimuth : blocks.size() >= 2 ? blocks[blocks.size() - 2].azimuth : last;
+      const uint16_t before = k >= 2               ? packet.blocks[k - 2].azimuth
+                              : blocks.size() >= 2 ? blocks[blocks.size() - 2].azimuth
+                                                   : last;
       const int step = (int(last) - int(before) + kHdl32eAzimuthUnits) % kHdl32eAzimuthUnits;
       packet.blocks[k].azimuth = uint16_t((last + step) % kHdl32eAzimuthUnits);
     }

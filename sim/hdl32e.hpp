@@ -92,6 +92,11 @@ struct Hdl32eConfig {
   // Full firing cycles in one revolution: 2170 at 10 Hz.
   int cycles_per_scan() const { return static_cast<int>(scan_period_ns() / cycle_period_ns()); }
   int64_t firing_time_ns(int cycle, int slot) const { return cycle * cycle_period_ns() + slot * firing_period_ns; }
+  // How far the head turns between a cycle's azimuth reading (its first firing) and the middle of its
+  // 32 firings: 15.5 slots, 0.064 deg at 10 Hz. Drivers place all 32 returns at the reading.
+  double mean_firing_lag_deg() const {
+    return 360.0 * rotation_hz * double(firing_period_ns) * 1e-9 * (kHdl32eLasers - 1) / 2.0;
+  }
   Eigen::Isometry3d mount() const;
 
   static std::array<double, kHdl32eLasers> default_elevations();

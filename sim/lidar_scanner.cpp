@@ -43,6 +43,10 @@ PoseAt constant_twist(const Eigen::Isometry3d& start, int64_t t0_ns, double v, d
 
 LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& materials, const WeatherConfig& weather)
     : config_(config), weather_(weather), returns_(config), mount_(config.mount()) {
+  // The mount is the frame the driver's points are in: a calibration fits the decoded clouds, so it
+  // absorbs the mean lag between a cycle's azimuth reading and its firings. The head itself sits that
+  // much counter-clockwise of it, and a cycle's rays straddle its reported azimuth, +-0.064 deg at 10 Hz.
+  mount_.rotate(Eigen::AngleAxisd(config.mean_firing_lag_deg() * kDeg, Eigen::Vector3d::UnitZ()));
   for (size_t i = 0; i < materials.size(); ++i) {
     Material m = materials[MaterialId(i)];
     if (weather.wet && is_one_of(m.name, kRoadMaterials)) m.reflectivity *= weather.wet_road_factor;
@@ -69,6 +73,7 @@ LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& mate
     const double yaw = config.scan_start_yaw_deg * kDeg + yaw_rate * double(config.firing_time_ns(cycle, 0)) * 1e-9;
     cycle_yaw_.emplace_back(float(std::cos(yaw)), float(std::sin(yaw)));
     cycle_azimuth_.push_back(hdl32e_azimuth(yaw));
+    cycle_rotation_.push_back(hdl32e_rotation(cycle_azimuth_.back()));
   }
 }
 
@@ -252,8 +257,8 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
       if (!valid[i] || ranges[i] < config_.min_range_m || ranges[i] > config_.max_range_m) continue;
       const long units = std::lround(double(ranges[i]) / kHdl32eDistanceUnitM);
       if (units <= 0 || units > std::numeric_limits<uint16_t>::max()) continue;  // not on the wire
-      const Hdl32ePoint p =
-          hdl32e_point(azimuth, slot_cos_elevation_[size_t(slot)], slot_sin_elevation_[size_t(slot)], uint16_t(units));
+      const Hdl32ePoint p = hdl32e_point(cycle_rotation_[size_t(cycle)], slot_cos_elevation_[size_t(slot)],
+                                         slot_sin_elevation_[size_t(slot)], uint16_t(units));
       cloud.points.push_back({p.x, p.y, p.z, intensities[i], uint16_t(config_.firing_order[size_t(slot)]),
                               uint32_t(config_.firing_time_ns(cycle, slot))});
       if (wire) {

@@ -4,13 +4,13 @@
 // Motion distortion: every firing cycle is cast from the sensor pose at its own time, so a scan taken
 // while driving or turning is skewed like a real one; within a cycle (36.9 us of firings) the origin
 // moves on linearly. Points are reported in the sensor frame of their own firing instant, as a
-// Velodyne driver reports them.
+// Velodyne driver reports them. Actors move during the scan too: their poses are keyframed every
+// `cycles_per_actor_update` cycles and each ray meets them where they are at its own time.
 //
 // Reported geometry: each ray is cast in its laser's true direction at its true firing time, but the
 // point reported is what a driver decodes from the sensor's packets (common/hdl32e_block.hpp): the
 // cycle's azimuth on the 0.01 deg grid for all 32 lasers of the cycle, the range on the 2 mm grid,
-// the laser's calibrated vertical angle. scan() can hand out those packet contents too. Actors move during the scan too: their poses are keyframed every
-// `cycles_per_actor_update` cycles and each ray meets them where they are at its own time.
+// the laser's calibrated vertical angle. scan() can hand out those packet contents too.
 //
 // Output order is firing order, and each ray's noise comes from a counter-based generator keyed by the
 // scan and the ray's index, so the cloud is identical whatever the number of threads.
@@ -88,10 +88,11 @@ class LidarScanner {
   Eigen::Isometry3d mount_;
   // Per firing slot: the beam's unit vector at zero yaw, with the slot's own yaw advance folded in.
   std::array<Eigen::Vector3f, kHdl32eLasers> slot_direction_;
-  std::vector<Eigen::Vector2f> cycle_yaw_;  // (cos, sin) of each cycle's starting yaw
-  std::vector<uint16_t> cycle_azimuth_;     // each cycle's starting yaw as the encoder reports it
+  std::vector<Eigen::Vector2f> cycle_yaw_;        // (cos, sin) of each cycle's starting yaw
+  std::vector<uint16_t> cycle_azimuth_;           // each cycle's starting yaw as the encoder reports it
+  std::vector<Hdl32eRotation2d> cycle_rotation_;  // and that azimuth's cosine and sine
   std::array<double, kHdl32eLasers> slot_cos_elevation_{}, slot_sin_elevation_{};
-  int keyframes_ = 2;                       // actor keyframes per scan, evenly spaced from the stamp
+  int keyframes_ = 2;  // actor keyframes per scan, evenly spaced from the stamp
   int64_t keyframe_step_ns_ = 0;
 };
 

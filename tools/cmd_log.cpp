@@ -157,8 +157,7 @@ int run_recover(const Args& args) {
 
 int run_export(const Args& args) {
   const std::string log = args.positional().at(0), topic = args.text("topic", "");
-  const int chosen =
-      int(args.flag("tum")) + int(args.flag("pcd")) + int(args.flag("kitti")) + int(args.flag("pcap"));
+  const int chosen = int(args.flag("tum")) + int(args.flag("pcd")) + int(args.flag("kitti")) + int(args.flag("pcap"));
   if (chosen != 1) throw InputError("export: give exactly one of --tum FILE, --pcd DIR, --kitti DIR, --pcap FILE");
   ExportResult r;
   std::string what, where;

@@ -38,7 +38,8 @@ int run_simulate(const Args& args) {
 
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   CsvStreams streams(out, LocalFrame(s.world.description.origin), scan_every);
-  const std::unique_ptr<RecordingSink> recorder = start_recording(args.value("record"), s.scenario, "", args.flag("packets"));
+  const std::unique_ptr<RecordingSink> recorder =
+      start_recording(args.value("record"), s.scenario, "", args.flag("packets"));
   TeeSink sink(streams, recorder.get());
   const bool terminal = isatty(STDOUT_FILENO);
   const auto t0 = std::chrono::steady_clock::now();

@@ -100,8 +100,8 @@ TEST(Hdl32ePackets, DecoderRejectsGarbage) {
   bad[1204] = 0x39;
   expect_rejected(bad, "return mode 57 is not single return");
   bad = good;
-  bad[1203] = 0xFF;  // 4.28e9 us: more than an hour
-  expect_rejected(bad, "timestamp 4278321924 us is past the hour");  // 0xFF020304
+  bad[1203] = 0xFF;  // 0xFF020304 = 4278321924 us: more than an hour
+  expect_rejected(bad, "timestamp 4278321924 us is past the hour");
 }
 
 TEST(Hdl32ePackets, TimestampIsMicrosecondsPastTheHour) {
@@ -141,9 +141,9 @@ TEST(Hdl32ePackets, NmeaChecksumMatchesAHandComputedSentence) {
   EXPECT_EQ(nmea_checksum("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A"), 0x6A);
   GpsFix fix;
   fix.status = GpsStatus::fix;
-  fix.lat_deg = 48.1173;                     // 48 deg 07.038'
-  fix.lon_deg = 11.0 + 31.0 / 60.0;          // 11 deg 31.000'
-  fix.heading_rad = (90.0 - 84.4) * M_PI / 180;  // course 84.4 deg from north
+  fix.lat_deg = 48.1173;                                           // 48 deg 07.038'
+  fix.lon_deg = 11.0 + 31.0 / 60.0;                                // 11 deg 31.000'
+  fix.heading_rad = (90.0 - 84.4) * M_PI / 180;                    // course 84.4 deg from north
   const int64_t t = ((12 * 60 + 35) * 60 + 19) * 1'000'000'000LL;  // 1970-01-01 12:35:19 UTC
   EXPECT_EQ(gprmc_sentence(t, fix, 22.4 * 1852.0 / 3600.0),
             "$GPRMC,123519,A,4807.03800,N,01131.00000,E,22.4,84.4,010170,,,A*74\r\n");
@@ -170,7 +170,7 @@ TEST(Hdl32ePackets, PositionPacketCarriesTimestampAndSentence) {
 }
 
 TEST(PcapFile, GlobalHeaderBytes) {
-  const std::array<uint8_t, 24> expected = {0xd4, 0xc3, 0xb2, 0xa1, 2, 0, 4, 0, 0, 0, 0, 0,
+  const std::array<uint8_t, 24> expected = {0xd4, 0xc3, 0xb2, 0xa1, 2,    0,    4, 0, 0, 0, 0, 0,
                                             0,    0,    0,    0,    0xff, 0xff, 0, 0, 1, 0, 0, 0};
   EXPECT_EQ(pcap_file_header(), expected);
 }
@@ -193,7 +193,7 @@ TEST(PcapFile, UdpFrameLayout) {
   EXPECT_EQ(f[13], 0x00);
   EXPECT_EQ(f[14], 0x45);
   EXPECT_EQ(f[16] << 8 | f[17], 20 + 8 + 1206);  // total length
-  EXPECT_EQ(f[18] << 8 | f[19], 7);             // identification
+  EXPECT_EQ(f[18] << 8 | f[19], 7);              // identification
   EXPECT_EQ(f[23], 17);                          // UDP
   EXPECT_EQ(f[26], 192);
   EXPECT_EQ(f[29], 201);

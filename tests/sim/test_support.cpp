@@ -41,7 +41,9 @@ Hdl32eConfig noiseless_hdl32e() {
 }
 
 Eigen::Vector3d fired_point(const LidarPoint& p, const Hdl32eConfig& config) {
-  const double fired_yaw = (config.scan_start_yaw_deg - 360.0 * config.rotation_hz * double(p.t_ns) * 1e-9) * M_PI / 180;
+  const double fired_yaw =
+      (config.scan_start_yaw_deg - 360.0 * config.rotation_hz * double(p.t_ns) * 1e-9 + config.mean_firing_lag_deg()) *
+      M_PI / 180;
   const Eigen::Vector3d reported(p.x, p.y, p.z);
   return Eigen::AngleAxisd(fired_yaw - std::atan2(reported.y(), reported.x()), Eigen::Vector3d::UnitZ()) * reported;
 }

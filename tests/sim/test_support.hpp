@@ -24,7 +24,8 @@ World world_from_yaml(const std::string& yaml, const std::string& name = "test_w
 Hdl32eConfig noiseless_hdl32e();
 // A point of a scan taken standing still, moved from where the driver reports it (its cycle's
 // azimuth) onto its laser's true firing direction (the scan's start yaw turned on to the point's own
-// firing time): where the ray actually met the world, up to the 2 mm range step.
+// firing time, in the mount frame, which absorbs the mean firing lag: sim/lidar_scanner.hpp): where
+// the ray actually met the world, up to the 2 mm range step.
 Eigen::Vector3d fired_point(const LidarPoint& p, const Hdl32eConfig& config);
 
 }  // namespace lidarloop::test
