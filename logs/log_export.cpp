@@ -13,8 +13,10 @@
 #include <vector>
 
 #include "common/input_error.hpp"
+#include "logs/hdl32e_packets.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
+#include "logs/pcap_file.hpp"
 #include "logs/pcd_file.hpp"
 #include "logs/ros2_messages.hpp"
 #include "logs/tum_file.hpp"
@@ -236,6 +238,73 @@ ExportResult export_kitti(const std::string& log, const std::string& dir, const 
     calib << "\n";
   }
   return {chosen, scans};
+}
+
+ExportResult export_pcap(const std::string& log, const std::string& file, const std::string& topic) {
+  const std::string chosen = topic.empty() ? log_topics::velodyne_packets : topic;
+  constexpr const char* kScanType = "velodyne_msgs/msg/VelodyneScan";
+  constexpr int64_t kNsPerS = 1'000'000'000;
+  // The sensor's factory address (the HDL-32E manual's default 192.168.1.201) and Velodyne's MAC
+  // prefix 60:76:88; it broadcasts (255.255.255.255), so any host on the link receives the capture.
+  const UdpEndpoints endpoints{{0x60, 0x76, 0x88, 0x00, 0x00, 0x01}, {192, 168, 1, 201}, {255, 255, 255, 255}};
+
+  // First pass: the GPS fixes with their headings, the ground-truth speed, and whether there are scans.
+  struct Fix {
+    GpsFix fix;
+    double speed = 0;
+  };
+  std::vector<Fix> fixes;
+  double speed = 0;
+  size_t scans = 0;
+  {
+    McapReader reader(log);
+    for (McapMessage m; reader.next(m);) {
+      const std::string& t = m.channel->topic;
+      if (t == chosen && has_type(m, kScanType)) {
+        ++scans;
+      } else if (t == log_topics::gps_fix && has_type(m, "sensor_msgs/msg/NavSatFix")) {
+        fixes.push_back({ros2::decode_nav_sat_fix(m.data, context(reader, m)), speed});
+      } else if (t == log_topics::gps_heading && has_type(m, "lidarloop_msgs/msg/GnssHeading")) {
+        const auto h = ros2::decode_gnss_heading(m.data, context(reader, m));
+        if (!fixes.empty() && fixes.back().fix.stamp_ns == h.stamp_ns) fixes.back().fix.heading_rad = h.heading;
+      } else if (t == log_topics::truth_state && has_type(m, "lidarloop_msgs/msg/TruthState")) {
+        speed = ros2::decode_truth_state(m.data, context(reader, m)).speed;
+      }
+    }
+    if (scans == 0)
+      throw InputError(log + ": no " + kScanType + " messages on topic '" + chosen +
+                       "': record the run with --record FILE.mcap --packets");
+  }
+
+  // Second pass: the data packets in order, a position packet at each whole second on the way.
+  McapReader reader(log);
+  PcapWriter pcap(file, endpoints);
+  size_t packets = 0, next_fix = 0;
+  std::optional<int64_t> next_second;
+  auto position_packets_until = [&](int64_t t_ns) {
+    for (; *next_second <= t_ns; *next_second += kNsPerS) {
+      while (next_fix < fixes.size() && fixes[next_fix].fix.stamp_ns <= *next_second) ++next_fix;
+      const Fix none{};
+      const Fix& f = next_fix > 0 ? fixes[next_fix - 1] : none;
+      const std::string nmea = gprmc_sentence(*next_second, f.fix, f.speed);
+      pcap.write_udp(*next_second, kHdl32ePositionPort, encode_hdl32e_position_packet(*next_second, nmea));
+    }
+  };
+  for (McapMessage m; reader.next(m);) {
+    if (m.channel->topic != chosen || !has_type(m, kScanType)) continue;
+    const std::string where = context(reader, m);
+    const ros2::VelodyneScan scan = ros2::decode_velodyne_scan(m.data, where);
+    for (size_t i = 0; i < scan.packets.size(); ++i) {
+      const ros2::VelodynePacket& p = scan.packets[i];
+      decode_hdl32e_packet(p.data, where + ", packet " + std::to_string(i));  // an HDL-32E packet, or stop
+      if (!next_second) next_second = (p.stamp_ns + kNsPerS - 1) / kNsPerS * kNsPerS;
+      position_packets_until(p.stamp_ns);
+      pcap.write_udp(p.stamp_ns, kHdl32eDataPort, p.data);
+      ++packets;
+    }
+  }
+  pcap.close();
+  return {chosen, packets};
 }
 
 }  // namespace lidarloop

@@ -4,7 +4,8 @@
 //   PCD    one binary PCD v0.7 per scan (x y z intensity ring time), with timestamps.txt;
 //   KITTI  the raw-data layout: velodyne_points/data/NNNNNNNNNN.bin (float32 x y z reflectance 0-1)
 //          with timestamps(_start|_end).txt, oxts/data/NNNNNNNNNN.txt from the RTK (else GPS) fixes
-//          with oxts/timestamps.txt and dataformat.txt, and calib_imu_to_velo.txt from /tf_static.
+//          with oxts/timestamps.txt and dataformat.txt, and calib_imu_to_velo.txt from /tf_static;
+//   PCAP   below.
 // Every export reads the whole log through McapReader, so a corrupt log stops it with an InputError.
 #include <cstddef>
 #include <string>
@@ -21,6 +22,12 @@ struct ExportResult {
 ExportResult export_tum(const std::string& log, const std::string& file, const std::string& topic = "");
 ExportResult export_pcd(const std::string& log, const std::string& dir, const std::string& topic = "");
 ExportResult export_kitti(const std::string& log, const std::string& dir, const std::string& topic = "");
+// PCAP   the HDL-32E's UDP traffic as a capture (logs/pcap_file.hpp) VeloView or the ROS driver replay:
+//        every data packet of a velodyne_msgs/msg/VelodyneScan topic (default /velodyne_packets, logged
+//        by `--record FILE --packets`) to port 2368, and a position packet with a $GPRMC from the GPS
+//        fix (/gps/fix) to port 8308 at every whole second; capture time = packet stamp.
+//        count = data packets.
+ExportResult export_pcap(const std::string& log, const std::string& file, const std::string& topic = "");
 
 // "YYYY-MM-DD HH:MM:SS.nnnnnnnnn", UTC, counting from the Unix epoch (KITTI's timestamp format).
 std::string kitti_timestamp(int64_t ns);

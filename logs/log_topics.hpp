@@ -17,6 +17,8 @@
 //   /localizer/odometry   nav_msgs/msg/Odometry             map -> base_link_estimate (with covariance)
 //   /tf                   tf2_msgs/msg/TFMessage            map -> base_link (truth), map -> base_link_estimate
 //   /tf_static            tf2_msgs/msg/TFMessage            base_link -> lidar (mount), base_link -> gps
+//   /velodyne_packets     velodyne_msgs/msg/VelodyneScan    lidar (with --packets: the scans' raw HDL-32E
+//                                                           packets, logs/hdl32e_packets.hpp)
 //
 // Frames: map is the local transverse Mercator frame (x east, y north, z up); base_link is the
 // vehicle frame (x forward, y left, z up, origin at the rear axle centre on the ground); the GPS
@@ -43,6 +45,7 @@ inline constexpr const char* truth_curb_visibility = "/truth/curb_visibility";
 inline constexpr const char* estimate = "/localizer/odometry";
 inline constexpr const char* tf = "/tf";
 inline constexpr const char* tf_static = "/tf_static";
+inline constexpr const char* velodyne_packets = "/velodyne_packets";
 
 inline constexpr const char* map_frame = "map";
 inline constexpr const char* vehicle_frame = "base_link";

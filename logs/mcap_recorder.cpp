@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "logs/hdl32e_packets.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/ros2_messages.hpp"
 #include "logs/ros2_schemas.hpp"
@@ -102,6 +103,12 @@ void McapRecorder::write_scan(const PointCloud& cloud) {
   static constexpr ChannelSpec points{t::scan, "sensor_msgs/msg/PointCloud2"};
   ros2::encode_point_cloud(cloud, t::lidar_frame, scan_buffer_);
   write(points, cloud.stamp_ns, scan_buffer_);
+}
+
+void McapRecorder::write_velodyne_scan(const Hdl32eRotation& rotation) {
+  static constexpr ChannelSpec spec{t::velodyne_packets, "velodyne_msgs/msg/VelodyneScan"};
+  ros2::VelodyneScan scan{rotation.start_ns, t::lidar_frame, hdl32e_data_packets(rotation)};
+  write(spec, scan.stamp_ns, ros2::encode_velodyne_scan(scan));
 }
 
 void McapRecorder::write_actors(int64_t stamp_ns, const std::vector<ros2::ActorState>& actors) {

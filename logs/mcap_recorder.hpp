@@ -14,6 +14,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/hdl32e_block.hpp"
 #include "common/point_cloud.hpp"
 #include "common/vehicle_messages.hpp"
 #include "logs/mcap/mcap_writer.hpp"
@@ -38,6 +39,8 @@ class McapRecorder {
   void write_scan(const PointCloud& cloud);
   void write_actors(int64_t stamp_ns, const std::vector<ros2::ActorState>& actors);
   void write_curb_visibility(const CurbVisibility& visibility);
+  // A scan as the HDL-32E's data packets (logs/hdl32e_packets.hpp), stamped with its first packet.
+  void write_velodyne_scan(const Hdl32eRotation& rotation);
 
   // The localizer's estimate: /localizer/odometry (covariance of x, y, yaw) and /tf.
   void write_estimate(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& cov_xy_yaw);

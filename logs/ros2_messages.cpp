@@ -35,20 +35,30 @@ size_t field_size(uint8_t datatype) {
   }
 }
 
-void header(CdrWriter& w, int64_t stamp_ns, const std::string& frame_id) {
+// builtin_interfaces/Time.
+void write_time(CdrWriter& w, int64_t stamp_ns) {
   const Stamp s = to_stamp(stamp_ns);
   w.i32(s.sec);
   w.u32(s.nanosec);
+}
+
+int64_t read_time(CdrReader& r) {
+  Stamp s;
+  s.sec = r.i32();
+  s.nanosec = r.u32();
+  return from_stamp(s);
+}
+
+void header(CdrWriter& w, int64_t stamp_ns, const std::string& frame_id) {
+  write_time(w, stamp_ns);
   w.string(frame_id);
 }
 
 int64_t header(CdrReader& r, std::string* frame_id = nullptr) {
-  Stamp s;
-  s.sec = r.i32();
-  s.nanosec = r.u32();
+  const int64_t stamp = read_time(r);
   std::string frame = r.string();
   if (frame_id) *frame_id = std::move(frame);
-  return from_stamp(s);
+  return stamp;
 }
 
 void vector3(CdrWriter& w, const Eigen::Vector3d& v) {
@@ -507,6 +517,31 @@ std::vector<ActorState> decode_actor_array(View cdr, const std::string& context,
     a.pose.yaw = r.f64();
   }
   return out;
+}
+
+Bytes encode_velodyne_scan(const VelodyneScan& scan) {
+  CdrWriter w;
+  w.reserve(scan.packets.size() * (8 + kVelodynePacketSize + 2));
+  header(w, scan.stamp_ns, scan.frame_id);
+  w.sequence_length(scan.packets.size());
+  for (const auto& p : scan.packets) {
+    write_time(w, p.stamp_ns);
+    w.raw(p.data);
+  }
+  return std::move(w.buffer());
+}
+
+VelodyneScan decode_velodyne_scan(View cdr, const std::string& context) {
+  CdrReader r(cdr, context);
+  VelodyneScan scan;
+  scan.stamp_ns = header(r, &scan.frame_id);
+  scan.packets.resize(r.sequence_length(8 + kVelodynePacketSize));
+  for (auto& p : scan.packets) {
+    p.stamp_ns = read_time(r);
+    const View data = r.raw(kVelodynePacketSize);
+    std::copy(data.begin(), data.end(), p.data.begin());
+  }
+  return scan;
 }
 
 }  // namespace lidarloop::ros2

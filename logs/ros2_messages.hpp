@@ -136,4 +136,19 @@ struct ActorState {
 Bytes encode_actor_array(int64_t stamp_ns, const std::vector<ActorState>& actors, const std::string& frame_id);
 std::vector<ActorState> decode_actor_array(View cdr, const std::string& context, int64_t* stamp_ns = nullptr);
 
+// velodyne_msgs/msg/VelodyneScan (ROS 2 velodyne driver): one revolution's raw UDP data packets, each
+// velodyne_msgs/msg/VelodynePacket {builtin_interfaces/Time stamp, uint8[1206] data}.
+inline constexpr size_t kVelodynePacketSize = 1206;
+struct VelodynePacket {
+  int64_t stamp_ns = 0;
+  std::array<uint8_t, kVelodynePacketSize> data{};
+};
+struct VelodyneScan {
+  int64_t stamp_ns = 0;
+  std::string frame_id;
+  std::vector<VelodynePacket> packets;
+};
+Bytes encode_velodyne_scan(const VelodyneScan& scan);
+VelodyneScan decode_velodyne_scan(View cdr, const std::string& context);
+
 }  // namespace lidarloop::ros2

@@ -147,6 +147,13 @@ const std::map<std::string, std::string>& definitions() {
        "int32 visible                    # samples the LiDAR sees\n"
        "int32 hidden                     # in sight of the static world, but an actor is in the way\n"
        "int32 blocked_by_world           # out of sight of the static world alone: in neither count\n"},
+      // velodyne_msgs (ros-drivers/velodyne, ros2 branch): the sensor's raw data packets.
+      {"velodyne_msgs/VelodynePacket",
+       "builtin_interfaces/Time stamp\n"
+       "uint8[1206] data\n"},
+      {"velodyne_msgs/VelodyneScan",
+       "std_msgs/Header header\n"
+       "velodyne_msgs/VelodynePacket[] packets\n"},
       {"lidarloop_msgs/ActorArray",
        "# Simulator ground truth of the traffic actors, at each LiDAR scan's stamp.\n"
        "std_msgs/Header header\n"

@@ -114,6 +114,9 @@ class PipelinedSink : public StreamSink {
     push(ScanMessage{cloud, sensor_pose});
     scan_outstanding_ = true;
   }
+  void on_lidar_rotation(const Hdl32eRotation& r) override {
+    if (also_) also_->on_lidar_rotation(r);  // the scan's packets, next to the scan
+  }
 
   // Waits for the last scan's estimate, hands out everything held back and stops the worker once it
   // has processed everything; rethrows what the localizers threw. Call after the run.
@@ -286,6 +289,7 @@ class SimulationTap : public StreamSink {
     ++result_.scans;
     next_.on_scan(cloud, sensor_pose);
   }
+  void on_lidar_rotation(const Hdl32eRotation& r) override { next_.on_lidar_rotation(r); }
   void on_curb_visibility(const CurbVisibility& v) override {
     result_.curb_visibility.push_back(v);
     next_.on_curb_visibility(v);

@@ -45,10 +45,12 @@ void RecordingSink::on_actors(int64_t stamp_ns, const std::vector<ActorSample>& 
 }
 
 std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>& path, const Scenario& scenario,
-                                               const std::string& method) {
+                                               const std::string& method, bool packets) {
+  if (packets && !path) throw InputError("--packets: needs --record FILE.mcap");
   if (!path) return nullptr;
   if (path->empty()) throw InputError("--record: needs a file name");
   auto recorder = std::make_unique<RecordingSink>(*path, scenario.lidar.mount());
+  recorder->record_packets(packets);
   McapRecorder& log = recorder->log();
   log.add_attachment(kScenarioAttachment, "application/yaml", scenario.text);
   log.add_attachment(kVehicleAttachment, "application/yaml", vehicle_yaml(scenario.ego.vehicle));

@@ -54,6 +54,10 @@ class TeeSink : public StreamSink {
     a_.on_curb_visibility(v);
     if (b_) b_->on_curb_visibility(v);
   }
+  void on_lidar_rotation(const Hdl32eRotation& r) override {
+    a_.on_lidar_rotation(r);
+    if (b_) b_->on_lidar_rotation(r);
+  }
 
  private:
   StreamSink& a_;
@@ -72,15 +76,22 @@ class RecordingSink : public StreamSink {
   void on_scan(const PointCloud& c, const Eigen::Isometry3d&) override { log_.write_scan(c); }
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override;
   void on_curb_visibility(const CurbVisibility& v) override { log_.write_curb_visibility(v); }
+  // `--packets`: each scan also as the HDL-32E's raw packets (velodyne_msgs/msg/VelodyneScan).
+  void on_lidar_rotation(const Hdl32eRotation& r) override {
+    if (packets_) log_.write_velodyne_scan(r);
+  }
+  void record_packets(bool on) { packets_ = on; }
 
   McapRecorder& log() { return log_; }
 
  private:
   McapRecorder log_;
+  bool packets_ = false;
 };
 
-// Null when `path` is empty. `method` is the localizer's, empty for `simulate`.
+// Null when `path` is empty. `method` is the localizer's, empty for `simulate`. `packets`: record
+// the HDL-32E's packets too (InputError without a path).
 std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>& path, const Scenario& scenario,
-                                               const std::string& method);
+                                               const std::string& method, bool packets = false);
 
 }  // namespace lidarloop

@@ -6,7 +6,10 @@ namespace lidarloop {
 
 std::array<double, kHdl32eLasers> Hdl32eConfig::default_elevations() {
   std::array<double, kHdl32eLasers> e{};
-  for (int ring = 0; ring < kHdl32eLasers; ++ring) e[ring] = (4.0 * ring - 92.0) / 3.0;
+  // 4/3 deg steps rounded to 0.01 deg, as the manual lists them and as the drivers' HDL-32E
+  // calibration holds them (vert_correction in the ROS driver's 32db.yaml and @foxglove/velodyne-cloud's
+  // 32db.json is -30.67 deg, not -30.6667): a driver places points with these angles.
+  for (int ring = 0; ring < kHdl32eLasers; ++ring) e[ring] = std::round((4.0 * ring - 92.0) / 3.0 * 100.0) / 100.0;
   return e;
 }
 

@@ -14,10 +14,13 @@ namespace lidarloop {
 constexpr int kHdl32eLasers = 32;
 
 struct Hdl32eConfig {
-  // Elevation of each laser by ring (0 = lowest): -30.67 deg to +10.67 deg in 4/3 deg steps.
+  // Elevation of each laser by ring (0 = lowest): -30.67 deg to +10.67 deg in 4/3 deg steps, rounded to
+  // 0.01 deg as in the HDL-32E calibration the drivers use.
   std::array<double, kHdl32eLasers> elevation_deg = default_elevations();
   // The ring fired in each of the 32 firing slots of a cycle: the lower and upper banks alternate,
-  // -30.67, -9.33, -29.33, -8.00, ..., -10.67, +10.67.
+  // -30.67, -9.33, -29.33, -8.00, ..., -10.67, +10.67. Slot k is also channel k of a data block: the
+  // drivers' HDL-32E calibration lists laser_id 0-31 in this order (32db.yaml in the ROS driver,
+  // 32db.json in @foxglove/velodyne-cloud), and both read channel j of a block as laser j.
   std::array<int, kHdl32eLasers> firing_order = default_firing_order();
   int64_t firing_period_ns = 1152;  // one laser every 1.152 us
   int slots_per_cycle = 40;         // 32 firings + 8 idle slots = 46.08 us per cycle
@@ -89,6 +92,11 @@ struct Hdl32eConfig {
   // Full firing cycles in one revolution: 2170 at 10 Hz.
   int cycles_per_scan() const { return static_cast<int>(scan_period_ns() / cycle_period_ns()); }
   int64_t firing_time_ns(int cycle, int slot) const { return cycle * cycle_period_ns() + slot * firing_period_ns; }
+  // How far the head turns between a cycle's azimuth reading (its first firing) and the middle of its
+  // 32 firings: 15.5 slots, 0.064 deg at 10 Hz. Drivers place all 32 returns at the reading.
+  double mean_firing_lag_deg() const {
+    return 360.0 * rotation_hz * double(firing_period_ns) * 1e-9 * (kHdl32eLasers - 1) / 2.0;
+  }
   Eigen::Isometry3d mount() const;
 
   static std::array<double, kHdl32eLasers> default_elevations();

@@ -43,6 +43,10 @@ PoseAt constant_twist(const Eigen::Isometry3d& start, int64_t t0_ns, double v, d
 
 LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& materials, const WeatherConfig& weather)
     : config_(config), weather_(weather), returns_(config), mount_(config.mount()) {
+  // The mount is the frame the driver's points are in: a calibration fits the decoded clouds, so it
+  // absorbs the mean lag between a cycle's azimuth reading and its firings. The head itself sits that
+  // much counter-clockwise of it, and a cycle's rays straddle its reported azimuth, +-0.064 deg at 10 Hz.
+  mount_.rotate(Eigen::AngleAxisd(config.mean_firing_lag_deg() * kDeg, Eigen::Vector3d::UnitZ()));
   for (size_t i = 0; i < materials.size(); ++i) {
     Material m = materials[MaterialId(i)];
     if (weather.wet && is_one_of(m.name, kRoadMaterials)) m.reflectivity *= weather.wet_road_factor;
@@ -54,6 +58,8 @@ LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& mate
   const double yaw_rate = -2 * M_PI * config.rotation_hz;
   for (int slot = 0; slot < kHdl32eLasers; ++slot) {
     const double elevation = config.elevation_deg[config.firing_order[slot]] * kDeg;
+    slot_cos_elevation_[slot] = std::cos(elevation);
+    slot_sin_elevation_[slot] = std::sin(elevation);
     const double yaw = yaw_rate * double(slot * config.firing_period_ns) * 1e-9;
     slot_direction_[slot] = Eigen::Vector3f(float(std::cos(elevation) * std::cos(yaw)),
                                             float(std::cos(elevation) * std::sin(yaw)), float(std::sin(elevation)));
@@ -66,6 +72,8 @@ LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& mate
   for (int cycle = 0; cycle < cycles; ++cycle) {
     const double yaw = config.scan_start_yaw_deg * kDeg + yaw_rate * double(config.firing_time_ns(cycle, 0)) * 1e-9;
     cycle_yaw_.emplace_back(float(std::cos(yaw)), float(std::sin(yaw)));
+    cycle_azimuth_.push_back(hdl32e_azimuth(yaw));
+    cycle_rotation_.push_back(hdl32e_rotation(cycle_azimuth_.back()));
   }
 }
 
@@ -111,15 +119,16 @@ std::vector<LidarRay> LidarScanner::rays(const PoseAt& vehicle_pose, int64_t sta
 }
 
 PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64_t stamp_ns, uint64_t seed,
-                              const ActorPoses& actor_poses) const {
+                              const ActorPoses& actor_poses, Hdl32eRotation* wire) const {
   const auto poses = cycle_poses(vehicle_pose, stamp_ns);
   const int cycles = int(poses.size());
   const CounterRng rng(seed, uint64_t(stamp_ns));
   const CounterRng faults(mix64(seed ^ kFaultStream), uint64_t(stamp_ns));
   const CounterRng spray_rng(mix64(seed ^ kSprayStream), uint64_t(stamp_ns));
   const size_t firings = size_t(cycles) * kHdl32eLasers;
-  std::vector<LidarPoint> points(firings);
-  std::vector<uint8_t> valid(firings, 0);
+  // What each firing measured: range (m, on the sensor's range resolution) and intensity.
+  std::vector<float> ranges(firings, 0.0f);
+  std::vector<uint8_t> intensities(firings, 0), valid(firings, 0);
   const float tnear = float(config_.min_range_m) * 0.5f, tfar = float(config_.max_range_m) * 1.05f;
   constexpr float kNoSurface = std::numeric_limits<float>::infinity();
   // For mixed returns: each firing's surface range and signal, and whether its point came from it.
@@ -204,11 +213,9 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
           if (spurious < surface) {
             const double r = std::round(spurious / config_.range_resolution_m) * config_.range_resolution_m;
             if (r < config_.min_range_m || r > config_.max_range_m) continue;
-            const Eigen::Vector3f p = sensor_direction(cycle, slot) * float(r);
             const double u = faults.uniform(kDrawsPerFiring * i + kRainIntensityDraw);
-            points[i] = {p.x(),          p.y(),
-                         p.z(),          uint8_t(std::lround(weather_.clutter_intensity * u)),
-                         uint16_t(ring), uint32_t(config_.firing_time_ns(cycle, slot))};
+            ranges[i] = float(r);
+            intensities[i] = uint8_t(std::lround(weather_.clutter_intensity * u));
             valid[i] = 1;
             continue;
           }
@@ -224,28 +231,48 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
             continue;
           const auto ret = returns_(material, hits[k].range, cos_incidence, ring, rng, i);
           if (!ret) continue;
-          const Eigen::Vector3f p = sensor_direction(cycle, slot) * ret->range;
-          points[i] = {p.x(),          p.y(),          p.z(),
-                       ret->intensity, uint16_t(ring), uint32_t(config_.firing_time_ns(cycle, slot))};
+          ranges[i] = ret->range;
+          intensities[i] = ret->intensity;
           valid[i] = 2;
         }
       }
     });
   };
   cast(0, cycles);
-  if (mixing) mix_depth_edges(surface_range, surface_signal, valid, faults, points);
+  if (mixing) mix_depth_edges(surface_range, surface_signal, valid, faults, ranges);
 
+  // What the sensor sends (one block per cycle: the cycle's azimuth, 2 mm distance units, integer
+  // intensities), and the points a driver makes of it: every laser of a block at the block's
+  // azimuth, though its ray left up to 31 slots (0.13 deg at 10 Hz) later.
   PointCloud cloud;
   cloud.stamp_ns = stamp_ns;
-  cloud.points.reserve(points.size());
-  for (size_t i = 0; i < points.size(); ++i)
-    if (valid[i]) cloud.points.push_back(points[i]);
+  cloud.points.reserve(firings);
+  if (wire) *wire = {stamp_ns, config_.cycle_period_ns(), std::vector<Hdl32eBlock>(size_t(cycles))};
+  for (int cycle = 0; cycle < cycles; ++cycle) {
+    const uint16_t azimuth = cycle_azimuth_[size_t(cycle)];
+    if (wire) wire->blocks[size_t(cycle)].azimuth = azimuth;
+    for (int slot = 0; slot < kHdl32eLasers; ++slot) {
+      const size_t i = size_t(cycle) * kHdl32eLasers + size_t(slot);
+      // The range limits hold for what the sensor reports, a mixed range included.
+      if (!valid[i] || ranges[i] < config_.min_range_m || ranges[i] > config_.max_range_m) continue;
+      const long units = std::lround(double(ranges[i]) / kHdl32eDistanceUnitM);
+      if (units <= 0 || units > std::numeric_limits<uint16_t>::max()) continue;  // not on the wire
+      const Hdl32ePoint p = hdl32e_point(cycle_rotation_[size_t(cycle)], slot_cos_elevation_[size_t(slot)],
+                                         slot_sin_elevation_[size_t(slot)], uint16_t(units));
+      cloud.points.push_back({p.x, p.y, p.z, intensities[i], uint16_t(config_.firing_order[size_t(slot)]),
+                              uint32_t(config_.firing_time_ns(cycle, slot))});
+      if (wire) {
+        wire->blocks[size_t(cycle)].distance[size_t(slot)] = uint16_t(units);
+        wire->blocks[size_t(cycle)].intensity[size_t(slot)] = intensities[i];
+      }
+    }
+  }
   return cloud;
 }
 
 void LidarScanner::mix_depth_edges(const std::vector<float>& surface_range, const std::vector<float>& surface_signal,
                                    const std::vector<uint8_t>& from_surface, const CounterRng& faults,
-                                   std::vector<LidarPoint>& points) const {
+                                   std::vector<float>& ranges) const {
   constexpr size_t L = kHdl32eLasers;
   const size_t cycles = surface_range.size() / L;
   // The angle between two firings of a laser, and the half width of its spot (both radians).
@@ -276,13 +303,10 @@ void LidarScanner::mix_depth_edges(const std::vector<float>& surface_range, cons
     }
   for (size_t i = 0; i < shift.size(); ++i) {
     if (shift[i] == 0 || from_surface[i] != 2) continue;
-    LidarPoint& p = points[i];
-    const double range = std::sqrt(double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z);
-    double mixed = range + shift[i];
+    double mixed = double(ranges[i]) + shift[i];
     if (config_.range_resolution_m > 0)
       mixed = std::round(mixed / config_.range_resolution_m) * config_.range_resolution_m;
-    const float scale = float(mixed / range);
-    p.x *= scale, p.y *= scale, p.z *= scale;
+    ranges[i] = float(mixed);
   }
 }
 

@@ -7,6 +7,11 @@
 // Velodyne driver reports them. Actors move during the scan too: their poses are keyframed every
 // `cycles_per_actor_update` cycles and each ray meets them where they are at its own time.
 //
+// Reported geometry: each ray is cast in its laser's true direction at its true firing time, but the
+// point reported is what a driver decodes from the sensor's packets (common/hdl32e_block.hpp): the
+// cycle's azimuth on the 0.01 deg grid for all 32 lasers of the cycle, the range on the 2 mm grid,
+// the laser's calibrated vertical angle. scan() can hand out those packet contents too.
+//
 // Output order is firing order, and each ray's noise comes from a counter-based generator keyed by the
 // scan and the ray's index, so the cloud is identical whatever the number of threads.
 //
@@ -20,6 +25,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/hdl32e_block.hpp"
 #include "common/point_cloud.hpp"
 #include "sim/hdl32e.hpp"
 #include "sim/lidar_return.hpp"
@@ -46,8 +52,9 @@ class LidarScanner {
   const Hdl32eConfig& config() const { return config_; }
   const WeatherConfig& weather() const { return weather_; }
 
+  // `wire`, when given, receives the scan's blocks as the sensor sends them, starting at stamp_ns.
   PointCloud scan(RayScene& scene, const PoseAt& vehicle_pose, int64_t stamp_ns, uint64_t seed,
-                  const ActorPoses& actor_poses = {}) const;
+                  const ActorPoses& actor_poses = {}, Hdl32eRotation* wire = nullptr) const;
 
   // The rays of one scan in firing order (cycle-major, then firing slot); scan() casts exactly these.
   std::vector<LidarRay> rays(const PoseAt& vehicle_pose, int64_t stamp_ns) const;
@@ -64,7 +71,7 @@ class LidarScanner {
   // Where a beam's spot straddles a depth edge, moves its range towards the other surface's.
   void mix_depth_edges(const std::vector<float>& surface_range, const std::vector<float>& surface_signal,
                        const std::vector<uint8_t>& from_surface, const CounterRng& faults,
-                       std::vector<LidarPoint>& points) const;
+                       std::vector<float>& ranges) const;
   // A volume of spray behind a moving actor over one keyframe interval: world -> box frame, where the
   // box spans x in [-length, 0], |y| <= width / 2, z in [0, height]; density in returns per metre.
   struct SprayBox {
@@ -81,8 +88,11 @@ class LidarScanner {
   Eigen::Isometry3d mount_;
   // Per firing slot: the beam's unit vector at zero yaw, with the slot's own yaw advance folded in.
   std::array<Eigen::Vector3f, kHdl32eLasers> slot_direction_;
-  std::vector<Eigen::Vector2f> cycle_yaw_;  // (cos, sin) of each cycle's starting yaw
-  int keyframes_ = 2;                       // actor keyframes per scan, evenly spaced from the stamp
+  std::vector<Eigen::Vector2f> cycle_yaw_;        // (cos, sin) of each cycle's starting yaw
+  std::vector<uint16_t> cycle_azimuth_;           // each cycle's starting yaw as the encoder reports it
+  std::vector<Hdl32eRotation2d> cycle_rotation_;  // and that azimuth's cosine and sine
+  std::array<double, kHdl32eLasers> slot_cos_elevation_{}, slot_sin_elevation_{};
+  int keyframes_ = 2;  // actor keyframes per scan, evenly spaced from the stamp
   int64_t keyframe_step_ns_ = 0;
 };
 

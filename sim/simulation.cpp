@@ -126,11 +126,13 @@ void Simulation::emit_scan(StreamSink& sink) {
     body.roll += f * (bodies[i + 1].roll - body.roll);
     return Eigen::Isometry3d(ground * body.pose());
   };
-  PointCloud cloud = scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses_);
+  PointCloud cloud =
+      scanner_.scan(*scene_, vehicle_pose, stamp, mix64(scenario_.seed ^ kLidarStream), actor_poses_, &rotation_);
   // The LiDAR's clock stamps the scan; the truth (sensor pose, actors) stays on the reference clock.
   cloud.stamp_ns = stamp_on(scenario_.clocks.lidar, stamp, lidar_clock_rng_, uint64_t(scan_index_));
   const Eigen::Isometry3d sensor_pose = vehicle_pose(stamp) * true_lidar_mount_;
   sink.on_scan(cloud, sensor_pose);
+  sink.on_lidar_rotation(rotation_);
   std::vector<ActorSample> states;
   for (const auto& a : resolved_.actors) states.push_back({a.name, a.type, actor_pose2d(a, stamp)});
   sink.on_actors(stamp, states);

@@ -32,6 +32,9 @@ class StreamSink {
   // sensor_pose: the LiDAR's true pose in the world (true mount, sim/sensor_calibration.hpp) at the
   // scan's first firing on the reference clock; the cloud's stamp is the LiDAR clock's (sim/clocks.hpp).
   virtual void on_scan(const PointCloud&, const Eigen::Isometry3d& /*sensor_pose*/) {}
+  // Right after on_scan: the same scan as the HDL-32E sends it (its blocks), on the reference clock
+  // (the sensor's clock is GPS-disciplined; the cloud's stamp is the host's, sim/clocks.hpp).
+  virtual void on_lidar_rotation(const Hdl32eRotation&) {}
   virtual void on_actors(int64_t /*stamp_ns*/, const std::vector<ActorSample>&) {}
   // After each scan: how much of the curb in the localizer's range the traffic hid from the LiDAR at
   // the scan's first firing (sim/curb_visibility.hpp), stamped on the reference clock.
@@ -70,6 +73,7 @@ class Simulation {
   Eigen::Isometry3d true_lidar_mount_;
   CounterRng lidar_clock_rng_;  // the LiDAR clock's jitter, by scan index
   LidarScanner scanner_;
+  Hdl32eRotation rotation_;  // the last scan's blocks, reused from scan to scan
   VehicleModel vehicle_;
   PathController controller_;
   CanModel can_;

@@ -157,8 +157,8 @@ int run_recover(const Args& args) {
 
 int run_export(const Args& args) {
   const std::string log = args.positional().at(0), topic = args.text("topic", "");
-  const int chosen = int(args.flag("tum")) + int(args.flag("pcd")) + int(args.flag("kitti"));
-  if (chosen != 1) throw InputError("export: give exactly one of --tum FILE, --pcd DIR, --kitti DIR");
+  const int chosen = int(args.flag("tum")) + int(args.flag("pcd")) + int(args.flag("kitti")) + int(args.flag("pcap"));
+  if (chosen != 1) throw InputError("export: give exactly one of --tum FILE, --pcd DIR, --kitti DIR, --pcap FILE");
   ExportResult r;
   std::string what, where;
   if (auto file = args.value("tum")) {
@@ -167,6 +167,9 @@ int run_export(const Args& args) {
   } else if (auto dir = args.value("pcd")) {
     r = export_pcd(log, *dir, topic);
     what = "scans", where = *dir;
+  } else if (auto pcap = args.value("pcap")) {
+    r = export_pcap(log, *pcap, topic);
+    what = "HDL-32E data packets", where = *pcap;
   } else {
     where = *args.value("kitti");
     r = export_kitti(log, where, topic);
@@ -202,12 +205,13 @@ Command recover_command() {
 
 Command export_command() {
   return {{"export",
-           "lidarloop export FILE.mcap (--tum FILE | --pcd DIR | --kitti DIR) [--topic TOPIC]",
-           "Convert a log: a trajectory to TUM (for evo), scans to PCD files, or scans and RTK fixes to\n"
-           "the KITTI raw-data layout.",
+           "lidarloop export FILE.mcap (--tum FILE | --pcd DIR | --kitti DIR | --pcap FILE) [--topic TOPIC]",
+           "Convert a log: a trajectory to TUM (for evo), scans to PCD files, scans and RTK fixes to\n"
+           "the KITTI raw-data layout, or the sensor's packets to a pcap capture (VeloView, ROS driver).",
            {{"tum", "FILE", "write a nav_msgs/Odometry topic as TUM (default: the estimate, else the truth)"},
             {"pcd", "DIR", "write each scan as a binary PCD file"},
             {"kitti", "DIR", "write the KITTI raw layout (velodyne_points, oxts, calib_imu_to_velo.txt)"},
+            {"pcap", "FILE", "write the HDL-32E's UDP packets (log recorded with --packets) as a pcap capture"},
             {"topic", "TOPIC", "the topic to export (default /localizer/odometry or /truth/odometry; /lidar/points)"}},
            1,
            1},

@@ -82,7 +82,7 @@ int run_run(const Args& args) {
   // Every output is opened before the map and the run: one that cannot be written fails at once.
   prepare_output_dir(out);
   const std::unique_ptr<RecordingSink> recorder =
-      start_recording(args.value("record"), s.scenario, method_text(params));
+      start_recording(args.value("record"), s.scenario, method_text(params), args.flag("packets"));
 
   HdMap map = open_scenario_map(s.scenario, s.world);
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
@@ -256,7 +256,7 @@ int run_compare(const Args& args) {
 Command run_command() {
   return {{"run",
            "lidarloop run SCENARIO.yaml [--method NAME] [--loop open|closed] [--out DIR] [--seed N]\n"
-           "                    [--record FILE.mcap]",
+           "                    [--record FILE.mcap [--packets]]",
            "Run a scenario with the localizer in the loop and score it against ground truth. Writes\n"
            "metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and plots to DIR. Exit 0 when\n"
            "every threshold of the scenario's `pass` holds, 1 when one fails, 2 on bad input.",
@@ -268,6 +268,7 @@ Command run_command() {
             {"realism", "PROFILE", "ideal, typical or harsh: replaces the scenario's realism profile"},
             {"duration", "S", "override the scenario's duration, seconds"},
             {"record", "FILE.mcap", "record every stream and the estimates as an MCAP log (replay redoes the run)"},
+            {"packets", "", "with --record: also log the HDL-32E's raw UDP packets on /velodyne_packets"},
             {"threads", "N", "worker threads (default: all cores)"}},
            1,
            1},

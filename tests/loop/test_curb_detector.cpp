@@ -222,7 +222,10 @@ TEST(CurbDetector, KeepsItsPrecisionAndRecallWithTrafficBesideTheCurbs) {
 // tilts 1:10 and must not pass for a curb (the rise is read where road and sidewalk meet the step).
 // Recall counts only crossings where the ground steps up by min_height (not across cuts, flares or the
 // bus bay). Its floors are regression guards a little under what the detector measured when they were
-// set (0.78, 0.66, 0.85, 0.99; with traffic 0.79 / 0.70), not goals.
+// set (0.78, 0.66, 0.85, 0.99; with traffic 0.79 / 0.70), not goals. Since points are placed as a
+// driver decodes the HDL-32E's packets (all lasers of a cycle at its azimuth, sim/lidar_scanner.hpp)
+// the traffic case measures 0.64 (36 of 56 crossings, was 39; the other cases moved by as much either
+// way: 0.81, 0.64, 0.86, 0.99), so its floor is 0.6.
 struct RealisticCase {
   const char* what;
   Straight road;
@@ -250,7 +253,7 @@ TEST(CurbDetector, KeepsItsPrecisionOnRealisticRoadsAndCurbs) {
     traffic.add(detect_on_straight(campus(), kLoopSouth, x, kRightLane, traffic_beside_the_curbs(x)));
   std::cout << "[ figures  ] crowned loop with traffic: " << traffic.figures() << "\n";
   EXPECT_GE(traffic.precision(), 0.75);
-  EXPECT_GE(traffic.recall(), 0.65);
+  EXPECT_GE(traffic.recall(), 0.6);
 }
 
 // The same traffic scenes through the `typical` HDL-32E: per-laser range biases, and mixed returns where

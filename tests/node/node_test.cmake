@@ -1,14 +1,7 @@
 # The Node.js cross-check, run by CTest (label `node`): the C++ writer records the synthetic run,
 # Foxglove's libraries read it back (read_mcap.mjs), and the C++ side compares what they found with
 # what was written. Arguments: CHECK (mcap_node_check), NODE, SCRIPT (read_mcap.mjs), WORKDIR.
-function(run)
-  execute_process(COMMAND ${ARGN} WORKING_DIRECTORY ${WORKDIR} RESULT_VARIABLE code OUTPUT_VARIABLE out
-                  ERROR_VARIABLE err TIMEOUT 300)
-  if(NOT code EQUAL 0)
-    message(FATAL_ERROR "failed (${code}): ${ARGN}\n${out}\n${err}")
-  endif()
-  set(out "${out}" PARENT_SCOPE)
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/run_step.cmake)
 
 run(${CHECK} write ${WORKDIR}/node_check.mcap)
 message(STATUS "${out}")

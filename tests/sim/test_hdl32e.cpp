@@ -1,5 +1,6 @@
 // HDL-32E geometry, timing, noise, motion distortion and determinism, checked against the datasheet
 // and against scenes whose geometry is known exactly.
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
@@ -69,12 +70,83 @@ TEST(Hdl32e, TimesFollowTheFiringSequenceAndTheHeadTurnsClockwise) {
     ASSERT_EQ(int64_t(p.t_ns) % kCycleNs, slot_of_ring(p.ring) * kFiringNs);
     cycles.insert(p.t_ns / kCycleNs);
     // Azimuth: starts at scan_start_yaw and decreases (clockwise seen from above) at 360 deg * 10 Hz.
-    const double expected = config.scan_start_yaw_deg - 360.0 * config.rotation_hz * double(p.t_ns) * 1e-9;
+    // A point is reported at its cycle's azimuth (the encoder reading at the cycle's first firing,
+    // on the 0.01 deg grid), as a driver decodes it, not at its own laser's later firing.
+    const int64_t cycle_start = p.t_ns - slot_of_ring(p.ring) * kFiringNs;
+    const double expected = config.scan_start_yaw_deg - 360.0 * config.rotation_hz * double(cycle_start) * 1e-9;
     const double error = std::remainder(std::atan2(p.y, p.x) / kDeg - expected, 360.0);
-    ASSERT_NEAR(error, 0.0, 1e-3);
+    ASSERT_NEAR(error, 0.0, 0.005 + 1e-4);  // half the 0.01 deg step, and float rounding
   }
   EXPECT_NEAR(double(cycles.size()), 2170.0, 2.0);
   EXPECT_EQ(*cycles.rbegin() - *cycles.begin() + 1, int64_t(cycles.size()));
+}
+
+// The cloud is what a driver decodes from the blocks the sensor sends: one block per cycle with the
+// cycle's azimuth, a return per channel (firing slot) in 2 mm units, and each point at the block's
+// azimuth and the channel's calibrated elevation.
+TEST(Hdl32e, ReportedPointsAreWhatTheWireCarries) {
+  const Hdl32eConfig config = test::noiseless_hdl32e();
+  RayScene scene(walled_plane());
+  const LidarScanner scanner(config, test::materials());
+  Hdl32eRotation wire;
+  const PointCloud cloud =
+      scanner.scan(scene, constant_twist(Eigen::Isometry3d::Identity(), 0, 0, 0), 5'000'000, 7, {}, &wire);
+  EXPECT_EQ(wire.start_ns, 5'000'000);
+  EXPECT_EQ(wire.cycle_period_ns, kCycleNs);
+  ASSERT_EQ(wire.blocks.size(), 2170u);
+  EXPECT_EQ(wire.blocks[0].azimuth, 18000);  // scan_start_yaw 180 deg: straight behind
+  // 0.1 s per turn: the encoder advances 360 deg * 46.08 us / 0.1 s = 0.165888 deg per cycle,
+  // reported to the nearest 0.01 deg: 180.17 deg, and 180 + 165.888 = 345.89 deg 1000 cycles on.
+  EXPECT_EQ(wire.blocks[1].azimuth, 18017);
+  EXPECT_EQ(wire.blocks[1000].azimuth, 34589);
+  size_t next = 0;
+  for (size_t cycle = 0; cycle < wire.blocks.size(); ++cycle) {
+    const Hdl32eBlock& block = wire.blocks[cycle];
+    for (int slot = 0; slot < 32; ++slot) {
+      if (block.distance[slot] == 0) continue;
+      ASSERT_LT(next, cloud.points.size());
+      const LidarPoint& p = cloud.points[next++];
+      const int ring = config.firing_order[slot];
+      ASSERT_EQ(p.ring, ring);
+      ASSERT_EQ(int64_t(p.t_ns), int64_t(cycle) * kCycleNs + slot * kFiringNs);
+      ASSERT_EQ(p.intensity, block.intensity[slot]);
+      const double v = kDatasheetElevation[ring] * kDeg;
+      const Hdl32ePoint q = hdl32e_point(block.azimuth, std::cos(v), std::sin(v), block.distance[slot]);
+      ASSERT_NEAR(p.x, q.x, 1e-5);
+      ASSERT_NEAR(p.y, q.y, 1e-5);
+      ASSERT_NEAR(p.z, q.z, 1e-5);
+      ASSERT_NEAR(std::sqrt(double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z), block.distance[slot] * 0.002,
+                  1e-5);
+    }
+  }
+  EXPECT_EQ(next, cloud.points.size());
+}
+
+// A beam fired late in its cycle is cast in its true direction but reported at the cycle's azimuth:
+// the last slot (ring 31, 35.7 us = 0.1285 deg of turn after the cycle began; 0.064 deg past the
+// cycle's mean firing, which the mount frame absorbs) meets the wall ahead at the range of its true
+// direction, so its reported x is W cos(block yaw) / cos(true yaw), not W.
+TEST(Hdl32e, ALateBeamIsCastLateButReportedAtItsBlockAzimuth) {
+  const Hdl32eConfig config = test::noiseless_hdl32e();
+  const PointCloud cloud = scan_static(walled_plane(), config);
+  const double late = 31 * 360.0 * config.rotation_hz * double(kFiringNs) * 1e-9 * kDeg;  // rad
+  std::vector<double> ahead;  // the wall's distance, from beams straight ahead
+  for (const auto& p : cloud.points)
+    if (p.ring == 31 && std::abs(std::atan2(p.y, p.x)) < 0.5 * kDeg) ahead.push_back(p.x);
+  ASSERT_GT(ahead.size(), 3u);
+  std::sort(ahead.begin(), ahead.end());
+  const double wall = ahead[ahead.size() / 2];
+  int checked = 0;
+  for (const auto& p : cloud.points) {
+    const double yaw = std::atan2(p.y, p.x);  // the block's, on the 0.01 deg grid
+    if (p.ring != 31 || std::abs(yaw) < 25 * kDeg || std::abs(yaw) > 40 * kDeg || p.x < 0) continue;
+    // Clockwise: the beam left later, further round; the head sits the mean lag counter-clockwise.
+    const double true_yaw = yaw - late + config.mean_firing_lag_deg() * kDeg;
+    ASSERT_NEAR(p.x, wall * std::cos(yaw) / std::cos(true_yaw), 0.004) << "yaw " << yaw / kDeg;
+    ASSERT_GT(std::abs(p.x - wall), 0.012);  // 0.064 deg at 25-40 deg off the normal: 1.5-2.7 cm
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
 }
 
 TEST(Hdl32e, RangeNoiseHasTheConfiguredSigmaAndRangesAreQuantised) {

@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include <cmath>
+
 namespace lidarloop::test {
 
 std::string data_path(const std::string& relative) { return std::string(LIDARLOOP_DATA_DIR) + "/" + relative; }
@@ -36,6 +38,14 @@ Hdl32eConfig noiseless_hdl32e() {
   c.dark_target_range_m = 1000;  // everything within max range is detected
   c.max_incidence_deg = 90;
   return c;
+}
+
+Eigen::Vector3d fired_point(const LidarPoint& p, const Hdl32eConfig& config) {
+  const double fired_yaw =
+      (config.scan_start_yaw_deg - 360.0 * config.rotation_hz * double(p.t_ns) * 1e-9 + config.mean_firing_lag_deg()) *
+      M_PI / 180;
+  const Eigen::Vector3d reported(p.x, p.y, p.z);
+  return Eigen::AngleAxisd(fired_yaw - std::atan2(reported.y(), reported.x()), Eigen::Vector3d::UnitZ()) * reported;
 }
 
 }  // namespace lidarloop::test

@@ -30,7 +30,7 @@ TriangleMesh painted_road() {
 }
 
 Eigen::Vector3d world_point(const LidarPoint& p, const Hdl32eConfig& c) {
-  return c.mount_xyz + Eigen::Vector3d(p.x, p.y, p.z);
+  return c.mount_xyz + test::fired_point(p, c);
 }
 
 TEST(Weather, WetPaintAndAsphaltReadTheConfiguredFractionOfTheirDryIntensity) {
