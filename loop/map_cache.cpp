@@ -32,8 +32,9 @@ constexpr uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3
 // formula in a fixed order (place, then lane), where one Welford stream ran lane after lane: the same
 // points per cell, means and variances that may differ in the last bit of the stored float (large: 44
 // of its cells' m2 by one ulp; campus: none). 5: the point-cloud layer (points.yaml, points/) for the
-// gicp method.
-constexpr int kMapFormatVersion = 5;
+// gicp method. 6: the survey's scans are the points a driver decodes from the HDL-32E's packets (block
+// azimuth on the 0.01 deg grid, 2 mm ranges, the calibration's elevations).
+constexpr int kMapFormatVersion = 6;
 
 static void hash_bytes(uint64_t& h, const std::string& bytes) {
   for (unsigned char c : bytes) h = (h ^ c) * kFnvPrime;
