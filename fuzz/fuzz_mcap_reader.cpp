@@ -27,6 +27,7 @@ const std::map<std::string, Decoder>& decoders() {
        [](auto v, auto& c) { ros2::decode_pose_with_covariance_stamped(v, c); }},
       {"geometry_msgs/msg/PoseStamped", [](auto v, auto& c) { ros2::decode_pose_stamped(v, c); }},
       {"tf2_msgs/msg/TFMessage", [](auto v, auto& c) { ros2::decode_tf(v, c); }},
+      {"velodyne_msgs/msg/VelodyneScan", [](auto v, auto& c) { ros2::decode_velodyne_scan(v, c); }},
   };
   return by_type;
 }

@@ -1,8 +1,9 @@
 // Writes the seed corpora that cannot be taken from the repository as they are: small logs recorded by
 // the project's own recorder (every topic type a run writes, chunked and compressed as `run --record`
 // writes them, uncompressed, unchunked as the exec: stream, and cut short as a killed run leaves them),
-// and the small map's files, each behind the byte that makes the map target replace it.
-//   make_fuzz_seeds OUT_DIR   ->  OUT_DIR/mcap/*.mcap, OUT_DIR/hd_map/*
+// the small map's files, each behind the byte that makes the map target replace it, and HDL-32E data
+// packets alone and in a VelodyneScan message.
+//   make_fuzz_seeds OUT_DIR   ->  OUT_DIR/mcap/*.mcap, OUT_DIR/hd_map/*, OUT_DIR/hdl32e_packet/*
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -10,6 +11,7 @@
 
 #include "fuzz/small_map.hpp"
 #include "localizer/map_files.hpp"
+#include "logs/hdl32e_packets.hpp"
 #include "logs/mcap_recorder.hpp"
 
 namespace {
@@ -19,6 +21,21 @@ namespace fs = std::filesystem;
 constexpr int kScans = 3;
 constexpr int kPointsPerScan = 24;
 constexpr int64_t kScanPeriodNs = 100'000'000;  // 10 Hz, as the HDL-32E's default rotation
+constexpr int64_t kCyclePeriodNs = 46'080;       // the HDL-32E's firing cycle: one block
+constexpr int kSeedBlocks = 2 * kHdl32eBlocksPerPacket;
+
+// Blocks of a scan's first two packets: the azimuth stepping on, returns on some channels, none on others.
+Hdl32eRotation seed_rotation(int64_t start_ns) {
+  Hdl32eRotation rotation{start_ns, kCyclePeriodNs, {}};
+  for (int b = 0; b < kSeedBlocks; ++b) {
+    Hdl32eBlock block;
+    block.azimuth = uint16_t(18000 + 17 * b);
+    for (int c = 0; c < kHdl32eChannels; ++c)
+      if ((b + c) % 5 != 0) block.distance[c] = uint16_t(500 + 97 * c), block.intensity[c] = uint8_t(3 * c + b);
+    rotation.blocks.push_back(block);
+  }
+  return rotation;
+}
 
 void record_log(const std::string& path, McapWriterOptions options) {
   McapRecorder log(path, Eigen::Isometry3d(Eigen::Translation3d(1.2, 0, 1.9)), options);
@@ -43,6 +60,7 @@ void record_log(const std::string& path, McapWriterOptions options) {
     for (int k = 0; k < kPointsPerScan; ++k)
       cloud.points.push_back({float(k), float(-k) * 0.5f, -1.9f, uint8_t(k * 7), uint16_t(k % 32), uint32_t(k * 1152)});
     log.write_scan(cloud);
+    log.write_velodyne_scan(seed_rotation(t));
     log.write_actors(t, {ros2::ActorState{"bus0", "bus", Pose2d{5.0 + i, 3.5, 0}}});
     log.write_estimate(t, Pose2d{1.0 * i + 0.02, 0.49, 0.01 * i}, Eigen::Matrix3d::Identity() * 0.01);
   }
@@ -82,5 +100,13 @@ int main(int argc, char** argv) {
     std::ofstream seed(out / "hd_map" / std::to_string(i), std::ios::binary);
     seed << char(i) << read_file_bytes(map / files[i], files[i]);
   }
+  fs::create_directories(out / "hdl32e_packet");
+  ros2::VelodyneScan scan{0, "lidar", hdl32e_data_packets(seed_rotation(0))};
+  for (size_t i = 0; i < scan.packets.size(); ++i)
+    std::ofstream(out / "hdl32e_packet" / ("packet" + std::to_string(i)), std::ios::binary)
+        .write(reinterpret_cast<const char*>(scan.packets[i].data.data()), std::streamsize(scan.packets[i].data.size()));
+  const ros2::Bytes cdr = ros2::encode_velodyne_scan(scan);
+  std::ofstream(out / "hdl32e_packet" / "velodyne_scan.cdr", std::ios::binary)
+      .write(reinterpret_cast<const char*>(cdr.data()), std::streamsize(cdr.size()));
   return 0;
 }
