@@ -43,15 +43,7 @@ static double coordinate(const json& v, const std::string& path, const char* wha
   return v.get<double>();
 }
 
-CurbMap read_curb_map(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open curb map");
-  json doc;
-  try {
-    doc = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(path + ": not valid JSON (" + e.what() + ")");
-  }
+static CurbMap curb_map_of(const json& doc, const std::string& path) {
   if (!doc.is_object() || doc.value("type", "") != "FeatureCollection" || !doc.contains("features") ||
       !doc["features"].is_array())
     throw InputError(path + ": not a GeoJSON FeatureCollection");
@@ -90,6 +82,20 @@ CurbMap read_curb_map(const std::string& path) {
   }
   if (!map.kinds.empty()) map.kinds.resize(map.curbs.size());
   return map;
+}
+
+CurbMap read_curb_map(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open curb map");
+  // Any json::exception is the file's fault, not only a parse_error: a number too large for a double
+  // (out_of_range, found by fuzz_hd_map), or a member of the wrong type where value() is asked for one.
+  try {
+    return curb_map_of(json::parse(in), path);
+  } catch (const json::parse_error& e) {
+    throw InputError(path + ": not valid JSON (" + e.what() + ")");
+  } catch (const json::exception& e) {
+    throw InputError(path + ": not a curb map (" + e.what() + ")");
+  }
 }
 
 }  // namespace lidarloop

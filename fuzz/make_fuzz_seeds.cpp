@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 constexpr int kScans = 3;
 constexpr int kPointsPerScan = 24;
 constexpr int64_t kScanPeriodNs = 100'000'000;  // 10 Hz, as the HDL-32E's default rotation
-constexpr int64_t kCyclePeriodNs = 46'080;       // the HDL-32E's firing cycle: one block
+constexpr int64_t kCyclePeriodNs = 46'080;      // the HDL-32E's firing cycle: one block
 constexpr int kSeedBlocks = 2 * kHdl32eBlocksPerPacket;
 
 // Blocks of a scan's first two packets: the azimuth stepping on, returns on some channels, none on others.
@@ -104,7 +104,8 @@ int main(int argc, char** argv) {
   ros2::VelodyneScan scan{0, "lidar", hdl32e_data_packets(seed_rotation(0))};
   for (size_t i = 0; i < scan.packets.size(); ++i)
     std::ofstream(out / "hdl32e_packet" / ("packet" + std::to_string(i)), std::ios::binary)
-        .write(reinterpret_cast<const char*>(scan.packets[i].data.data()), std::streamsize(scan.packets[i].data.size()));
+        .write(reinterpret_cast<const char*>(scan.packets[i].data.data()),
+               std::streamsize(scan.packets[i].data.size()));
   const ros2::Bytes cdr = ros2::encode_velodyne_scan(scan);
   std::ofstream(out / "hdl32e_packet" / "velodyne_scan.cdr", std::ios::binary)
       .write(reinterpret_cast<const char*>(cdr.data()), std::streamsize(cdr.size()));

@@ -239,6 +239,21 @@ TEST(GeodeticCurbMapFile, InvalidJson) {
   expect_curb_map_error("invalid_json", R"({"type": "FeatureCollection", "features": [)", "not valid JSON");
 }
 
+// Found by fuzz_hd_map: JSON that parses only up to a number beyond double's range, and members of
+// another type than the reader asks value() for, threw nlohmann's own exceptions past the reader.
+TEST(GeodeticCurbMapFile, JsonTheReaderCannotUseIsAnInputErrorToo) {
+  expect_curb_map_error("huge_number", collection("") + " 1e999999", "not valid JSON");
+  expect_curb_map_error("huge_coordinate",
+                        collection(R"({"type": "Feature", "properties": {}, "geometry": {"type": "LineString",
+                                      "coordinates": [[1e999999, 31.2856], [121.2147, 31.2856]]}})"),
+                        "number overflow");
+  expect_curb_map_error("type_not_a_string", R"({"type": 7, "features": []})", "not a curb map");
+  expect_curb_map_error("geometry_type_not_a_string",
+                        collection(R"({"type": "Feature", "properties": {}, "geometry": {"type": 2,
+                                      "coordinates": [[121.2147, 31.2856], [121.2148, 31.2856]]}})"),
+                        "not a curb map");
+}
+
 TEST(GeodeticCurbMapFile, NotAFeatureCollection) {
   expect_curb_map_error("not_collection",
                         R"({"type": "Feature", "geometry": {"type": "LineString", "coordinates": [[0, 0], [1, 1]]}})",
