@@ -10,6 +10,7 @@
 #include "localizer/map_files.hpp"
 #include "localizer/point_map.hpp"
 #include "logs/pcd_file.hpp"
+#include "loop/run_outputs.hpp"
 #include "loop/survey_map.hpp"
 
 namespace lidarloop {
@@ -76,16 +77,10 @@ void write_projector_info(const std::string& path, const Geodetic& origin) {
 
 }  // namespace
 
-void make_export_folder(const std::string& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw InputError(dir + ": cannot create the export folder (" + ec.message() + ")");
-}
-
 AutowareExportSummary export_autoware_map(const std::string& world, const MappingOptions& options,
                                           const std::string& map_dir, const std::string& out_dir,
                                           const AutowareExportConfig& config) {
-  make_export_folder(out_dir);
+  prepare_output_dir(out_dir);
   const LoadedWorld w = load_mapped_world(world, options);
   AutowareExportSummary summary;
   summary.dir = out_dir;

@@ -39,9 +39,6 @@ inline constexpr const char* kAutowarePointCloudFile = "pointcloud_map.pcd";
 inline constexpr const char* kAutowareLanelet2File = "lanelet2_map.osm";
 inline constexpr const char* kAutowareProjectorFile = "map_projector_info.yaml";
 
-// Makes the export folder (and its parents) if missing; InputError naming it if it cannot be made.
-void make_export_folder(const std::string& dir);
-
 // Exports the map in `map_dir` (built by ensure_map from `world` with `options`) to `out_dir`, which is
 // made if missing. InputError naming the folder or file that cannot be written, or a voxel finer than
 // the point layer's.

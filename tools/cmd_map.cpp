@@ -16,6 +16,7 @@
 #include "localizer/hd_map.hpp"
 #include "loop/autoware_export.hpp"
 #include "loop/map_cache.hpp"
+#include "loop/run_outputs.hpp"
 #include "sim/path.hpp"
 #include "sim/world_assets.hpp"
 #include "tools/commands.hpp"
@@ -81,7 +82,7 @@ std::optional<std::string> export_dir(const Args& args) {
   if (*format != "autoware") throw InputError("--export: unknown format '" + *format + "' (known: autoware)");
   if (!has_dir)
     throw InputError("--export " + *format + " needs a folder: lidarloop map WORLD --export " + *format + " DIR");
-  make_export_folder(args.positional().at(1));
+  prepare_output_dir(args.positional().at(1));
   return args.positional().at(1);
 }
 
