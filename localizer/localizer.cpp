@@ -150,7 +150,8 @@ std::string describe_health(uint32_t flags) {
                                                                   "intensity match rejected",
                                                                   "intensity match ambiguous",
                                                                   "no point match",
-                                                                  "point match rejected"};
+                                                                  "point match rejected",
+                                                                  "lost"};
   if (flags == 0) return "ok";
   std::string out;
   for (int i = 0; i < kHealthFlagCount; ++i)

@@ -15,6 +15,7 @@
 // (gicp_matcher.hpp), fused as the curb observation is (KF2 x, y, psi, the same chi^2 gate).
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <random>
 #include <string>
@@ -50,8 +51,11 @@ enum HealthFlag : uint32_t {
   kIntensityAmbiguous = 1u << 11,  // APS's distribution was as wide as its window on every axis it may update
   kNoPointMatch = 1u << 12,        // gicp: no point-cloud layer, too few map or scan points to register
   kPointMatchRejected = 1u << 13,  // gicp: not converged, too few scan points matched, or the gate refused it
+  // The pose is not to be trusted: the filter has not converged since a cold start, or the observations
+  // stopped agreeing with it. The localizer is relocalizing (a wide search) until they agree again.
+  kLost = 1u << 14,
 };
-constexpr int kHealthFlagCount = 14;
+constexpr int kHealthFlagCount = 15;
 // "ok", or the set flags as words: "no GPS, few curbs".
 std::string describe_health(uint32_t flags);
 
@@ -87,8 +91,15 @@ struct LocalizerEstimate {
   double point_fitness = 0;                 // gicp: fraction of the downsampled scan's points matched
   std::array<double, kStageCount> stage_ms{};
   double total_ms = 0;
+  bool wide_search = false;  // this scan ran (a share of) a relocalization's wide search
+
+  // Integrity: the lateral and longitudinal error (m, in the estimate's own vehicle frame) that the
+  // estimate exceeds with at most the probability LocalizerParams::integrity states. Infinite while lost.
+  double protection_lateral_m = std::numeric_limits<double>::infinity();
+  double protection_longitudinal_m = std::numeric_limits<double>::infinity();
 
   bool ok() const { return health == 0; }
+  bool lost() const { return (health & kLost) != 0; }
 };
 
 // The features of the last scan, for pictures (the paper's Fig. 14); vehicle frame.

@@ -66,7 +66,10 @@ std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate
                      {e.pose.x, e.pose.y, ros2::published_yaw(e.pose.yaw)},
                      e.covariance,
                      describe_health(e.health),
-                     e.total_ms});
+                     e.total_ms,
+                     e.lost(),
+                     e.protection_lateral_m,
+                     e.protection_longitudinal_m});
   return out;
 }
 

@@ -41,6 +41,20 @@ struct EstimateRecord {
   // Wall time the localizer spent on this frame; NaN when not known (an estimate read from a file),
   // and the latency metrics are then null rather than an invented 0.
   double latency_ms = std::numeric_limits<double>::quiet_NaN();
+  // The localizer's own word that it is lost (its pose is not to be trusted): such a frame is never
+  // counted as misleading. False when not known.
+  bool lost = false;
+  // Protection bounds (m): the lateral and longitudinal error the localizer says this estimate stays
+  // within at its stated probability; NaN when not given (an estimate read from a file without them).
+  double protection_lateral_m = std::numeric_limits<double>::quiet_NaN();
+  double protection_longitudinal_m = std::numeric_limits<double>::quiet_NaN();
+};
+
+// A moment a localizer must recover from: the start of the run, a GPS jump, a kidnap (the scenario's
+// faults). The scorer measures how long after it the error settles and `lost` is raised and cleared.
+struct FaultEvent {
+  int64_t stamp_ns = 0;
+  std::string what;  // "start", "gps jump", "kidnap"
 };
 
 // And, for the run's occlusion, the simulator's per-scan curb visibility (common/curb_visibility.hpp):
