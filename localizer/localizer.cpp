@@ -180,6 +180,12 @@ void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Ma
   filter_.emplace(pose, covariance, params_.filter);
 }
 
+void Localizer::displace(const Pose2d& offset) {
+  if (!filter_) return;
+  const Eigen::Matrix3d covariance = filter_->covariance();
+  filter_.emplace(filter_->pose().compose(offset), covariance, params_.filter);
+}
+
 std::optional<Pose2d> Localizer::pose() const {
   if (!filter_) return std::nullopt;
   return filter_->pose();

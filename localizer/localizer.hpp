@@ -126,6 +126,10 @@ class Localizer {
   // A known start instead of waiting for the first GPS fix.
   void initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance);
   bool initialized() const { return filter_.has_value(); }
+  // A kidnap, for testing relocalization: the filter's pose moves by `offset` (x forward, y left in its
+  // own vehicle frame, yaw added) and keeps its covariance, so it does not know. No-op before
+  // initialisation.
+  void displace(const Pose2d& offset);
   // The filter's current pose (predicted to the latest message); nullopt before initialisation.
   std::optional<Pose2d> pose() const;
 

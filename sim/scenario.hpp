@@ -86,6 +86,15 @@ PassThresholds load_pass_file(const std::string& path, const PassThresholds& bas
 PassThresholds parse_pass_assignment(const std::string& assignment, const std::string& what,
                                      const PassThresholds& base);
 
+// A fault done to the localizer rather than to the world (`faults:`): at at_s its pose estimate is
+// moved by `offset` (m, forward and left in its own vehicle frame) and turned by yaw, its covariance
+// left as it was, so it does not know (a kidnapped robot).
+struct KidnapFault {
+  double at_s = 0;
+  Eigen::Vector2d offset_m{0, 0};
+  double yaw_rad = 0;
+};
+
 struct Scenario {
   std::string file;
   std::string text;              // the YAML as read: recorded with logs, re-read for `localizer`
@@ -104,6 +113,7 @@ struct Scenario {
   MountErrorConfig mount_error;  // the true LiDAR mount and GPS antenna against the nominal `lidar` / `gps` ones
   ClockConfig clocks;            // the LiDAR's and the CAN's stamping clocks against the reference
   std::vector<TrafficSpec> traffic;
+  std::vector<KidnapFault> kidnaps;  // `faults:` entries of kind kidnap
   // `localizer`: the method here; the rest of the section (parameter overrides) belongs to the
   // localizer and is read by the tools from `text`, since sim/ does not know the localizer.
   std::string localizer_method = "proposed";
