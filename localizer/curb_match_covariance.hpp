@@ -16,10 +16,13 @@
 namespace lidarloop {
 
 struct CurbMatchNoise {
-  // Across-curb noise of one curb feature (m). Larger than the detector's centimetres: the features of
-  // one scan are not independent (the accumulated frames share odometry errors, neighbouring curbs share
-  // the map's digitising error), and this is the simple way to say so.
-  double point_sigma_m = 0.2;
+  // The across-curb noise of one feature is measured, per match, from the residuals of its features to
+  // the map's curb lines; this is its floor (m): the detector's centimetres.
+  double min_point_sigma_m = 0.01;
+  // The features are not independent: those along the same few metres of curb share the map's
+  // digitising error and the odometry that placed their frames (Eq. 4-5 accumulates frames over a few
+  // metres of driving). Features count as one per square of this side (m) that holds any.
+  double correlation_length_m = 4.0;
   double inlier_distance_m = 1.0;  // features farther from the map than this carry no information (d_g)
   // Floors, so that a perfect-looking match is never trusted beyond what a map can be trusted.
   double min_sigma_m = 0.03;

@@ -151,7 +151,8 @@ std::string describe_health(uint32_t flags) {
                                                                   "intensity match ambiguous",
                                                                   "no point match",
                                                                   "point match rejected",
-                                                                  "lost"};
+                                                                  "lost",
+                                                                  "GPS rejected"};
   if (flags == 0) return "ok";
   std::string out;
   for (int i = 0; i < kHealthFlagCount; ++i)
@@ -173,7 +174,9 @@ Localizer::Localizer(HdMap& map, const LocalizerParams& params)
       rng_(params.seed),
       predictor_(params.vehicle),
       accumulator_(params.curb_features.frames),
-      intensity_calibration_(params.intensity_calibration) {}
+      intensity_calibration_(params.intensity_calibration),
+      lost_(params.lost),
+      gps_steps_(params.gps_steps) {}
 
 void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance) {
   predict_to(stamp_ns);
@@ -237,8 +240,37 @@ void Localizer::on_gps(const GpsFix& fix) {
                                 .asDiagonal();
   last_gps_ns_ = fix.stamp_ns;
   if (!filter_) {
-    // One fix is as good as the receiver says; the scale is for the correlation between many.
+    // One fix is as good as the receiver says; the scale is for the correlation between many. A cold
+    // start: lost until the map has pinned the pose down.
     filter_.emplace(Pose2d{p.x(), p.y(), wrap_angle(fix.heading_rad)}, R, params_.filter);
+    lost_.start_search();
+    pose_when_lost_ = filter_->pose();
+    return;
+  }
+  const Eigen::Vector2d innovation = p - xy(filter_->pose());
+  const bool stepped = gps_steps_.step(fix.stamp_ns, innovation);
+  const double sigma = gps_steps_.noise_sigma_m();
+  if (gps_fault_level_) {
+    // Rejected until the jump ends: a fix that steps back to the level it had before.
+    if (stepped && (innovation - *gps_fault_level_).squaredNorm() / (sigma * sigma) <= params_.gps_steps.step_gate) {
+      gps_fault_level_.reset();
+      gps_steps_.restart();
+    }
+    return;
+  }
+  if (lost_.lost()) {
+    // While lost the filter itself moves by metres, so steps say nothing new; only the fixes that
+    // stepped before (the GPS may be what jumped) wait for the map's verdict.
+    if (!(gps_stepped_ && stepped))
+      filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
+    return;
+  }
+  // The fix itself beyond the receiver's own error (its variance, not the scaled one), or a step.
+  const Eigen::Matrix2d S = filter_->covariance().topLeftCorner<2, 2>() + R.topLeftCorner<2, 2>();
+  if (stepped || innovation.dot(S.ldlt().solve(innovation)) > params_.health.gate_gps) {
+    gps_stepped_ = gps_stepped_ || stepped;
+    last_gps_step_ = innovation;
+    disagree(innovation, 0);
     return;
   }
   filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
@@ -328,7 +360,9 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
     const std::optional<PoseObservation> z = match_curbs(features_.curbs, e);  // 3.1
     if (z) fuse_curbs(*z, e);                                                  // 3.3
   }
-  if (S) {
+  if (S && lost_.searching()) {
+    relocalize(*S, e);
+  } else if (S) {
     const std::optional<ApsResult> z = match_intensity(*S, e);  // 3.2
     if (z) fuse_intensity(*z, e);                               // 3.3
   }
@@ -478,8 +512,15 @@ bool Localizer::fuse_pose(const PoseObservation& z, int& rejections, LocalizerEs
   const Pose2d prior = filter_->pose();
   const Eigen::Vector3d innovation(z.pose.x - prior.x, z.pose.y - prior.y, wrap_angle(z.pose.yaw - prior.yaw));
   const Eigen::Matrix3d S = filter_->covariance() + z.covariance;
-  if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_curb, rejections)) return false;
+  if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_curb, rejections)) {
+    disagree(innovation.head<2>(), 0);
+    return false;
+  }
   filter_->update_curb(Eigen::Vector3d(z.pose.x, z.pose.y, z.pose.yaw), z.covariance);  // KF2
+  // Curbs along a straight road say nothing of the position along it.
+  const Eigen::Vector2d forward(std::cos(prior.yaw), std::sin(prior.yaw));
+  const double along_sigma = std::sqrt(forward.dot(z.covariance.topLeftCorner<2, 2>() * forward));
+  agree(prior, along_sigma <= params_.lost.converged_sigma_m, true);
   return true;
 }
 
@@ -540,7 +581,11 @@ std::optional<ApsResult> Localizer::match_intensity(IntensityGrid& S, LocalizerE
     return std::nullopt;
   }
   if (aps.peak_on_edge) {
+    // The truth may lie beyond the window.
     e.health |= kIntensityMatchRejected;
+    const ApsParams window = aps_window(S.pose);
+    disagree(Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()),
+             std::hypot(window.longitudinal_range_m, window.lateral_range_m));
     return std::nullopt;
   }
   e.intensity_observation = aps.position;
@@ -577,6 +622,7 @@ void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
   const Eigen::Matrix2d S = filter_->covariance().topLeftCorner<2, 2>() + R;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
     e.health |= kIntensityMatchRejected;
+    disagree(innovation, 0);
     return;
   }
   // Beyond the paper: an axis along which Eq. 14's distribution is about as wide as the search window
@@ -605,12 +651,100 @@ void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
     filter_->update_intensity_along(aps.position, R, along ? forward : left);
   else
     e.health |= kIntensityAmbiguous;
+  if (along || across) agree(prior, along, across);
 }
 
-void Localizer::report_pose(LocalizerEstimate& e) const {
+double Localizer::position_sigma() const {
+  return std::sqrt(filter_->covariance().topLeftCorner<2, 2>().eigenvalues().real().maxCoeff());
+}
+
+void Localizer::agree(const Pose2d& prior, bool along, bool across) {
+  const bool was_lost = lost_.lost();
+  lost_.agree(along, across, position_sigma());
+  if (!lost_.lost()) {
+    if (was_lost) {
+      // Found and confirmed: the GPS's level is learnt anew against the pose now trusted.
+      gps_steps_.restart();
+      gps_stepped_ = false;
+    } else {
+      // The map corrected the filter: every GPS innovation moves by as much, and that is no step.
+      gps_steps_.shift(xy(prior) - xy(filter_->pose()));
+    }
+  }
+}
+
+void Localizer::disagree(const Eigen::Vector2d& innovation, double reach_m) {
+  const bool was_searching = lost_.searching();
+  lost_.disagree({time_ns_, innovation, reach_m});
+  if (lost_.searching() && !was_searching) pose_when_lost_ = filter_->pose();
+  if (lost_.searching()) widen_to(lost_.disagreements(time_ns_));
+}
+
+void Localizer::widen_to(const std::deque<Disagreement>& refused) {
+  double reach = 0;
+  for (const Disagreement& d : refused)
+    reach = std::max(reach, d.innovation.allFinite() ? d.innovation.norm() : d.reach_m);
+  const RelocalizationParams& r = params_.relocalization;
+  const double sigma = reach / r.lost_offset_sigmas, yaw_sigma = r.lost_yaw_sigma_deg / kDegPerRad;
+  const Eigen::Matrix3d& P = filter_->covariance();
+  filter_->inflate(Eigen::Vector3d(std::max(0.0, sigma * sigma - P(0, 0)), std::max(0.0, sigma * sigma - P(1, 1)),
+                                   std::max(0.0, yaw_sigma * yaw_sigma - P(2, 2)))
+                       .asDiagonal());
+}
+
+// While lost: APS over the filter's whole spread (window_sigmas of it, within the bounds). A distinct
+// peak moves the filter there with APS's covariance, to be confirmed by the next matches; a broad or
+// edge-bound one leaves it for the next scan.
+void Localizer::relocalize(IntensityGrid& S, LocalizerEstimate& e) {
+  const StageTimer timer(stage_ms(e, Stage::intensity_matching));
+  e.wide_search = true;
+  const Pose2d before = filter_->pose();
+  S.pose = before;
+  const RelocalizationParams& r = params_.relocalization;
+  const double c = std::cos(before.yaw), s = std::sin(before.yaw);
+  Eigen::Matrix2d to_vehicle;
+  to_vehicle << c, s, -s, c;
+  const Eigen::Matrix2d spread = to_vehicle * filter_->covariance().topLeftCorner<2, 2>() * to_vehicle.transpose();
+  ApsParams aps = params_.aps;
+  auto range = [&](double variance, double max_range) {
+    const double wanted = std::clamp(r.window_sigmas * std::sqrt(std::max(variance, 0.0)), r.min_range_m,
+                                     std::max(r.min_range_m, max_range));
+    return std::floor(wanted / aps.step_m + kWholeStepTolerance) * aps.step_m;
+  };
+  aps.longitudinal_range_m = range(spread(0, 0), r.max_longitudinal_m);
+  aps.lateral_range_m = range(spread(1, 1), r.max_lateral_m);
+  const ApsResult found = aps_match(S, map_.intensity, aps);
+  e.intensity_cells = found.cells_used;
+  if (!found.ok || found.peak_on_edge || found.spread_ratio.maxCoeff() > params_.aps_max_spread_ratio) return;
+  e.intensity_observation = found.position;
+  Eigen::Matrix3d covariance = filter_->covariance();
+  covariance.topLeftCorner<2, 2>() = found.covariance * params_.aps_covariance_scale;
+  covariance.block<2, 1>(0, 2).setZero();
+  covariance.block<1, 2>(2, 0).setZero();
+  filter_.emplace(Pose2d{found.position.x(), found.position.y(), before.yaw}, covariance, params_.filter);
+  lost_.found();
+  // Who jumped? If the map found the car about where the filter had it, the GPS did: it is rejected
+  // until it steps back (its level is learnt anew once the pose is confirmed).
+  if (gps_stepped_ && pose_when_lost_ && last_gps_step_) {
+    const double moved = (found.position - xy(*pose_when_lost_)).norm();
+    if (moved < 0.5 * last_gps_step_->norm()) gps_fault_level_ = gps_steps_.level();
+  }
+  gps_stepped_ = false;
+}
+
+void Localizer::report_pose(LocalizerEstimate& e) {
   if (filter_) {
     e.pose = filter_->pose();
     e.covariance = filter_->covariance();
+    if (gps_fault_level_) e.health |= kGpsRejected;
+    if (lost_.lost()) {
+      e.health |= kLost;  // the bounds stay infinite
+    } else {
+      const ProtectionBounds b =
+          protection_bounds(e.covariance, e.pose, lost_.disagreements(e.stamp_ns), params_.integrity);
+      e.protection_lateral_m = b.lateral_m;
+      e.protection_longitudinal_m = b.longitudinal_m;
+    }
   } else {
     e.health |= kNotInitialized;
     e.covariance = Eigen::Matrix3d::Identity() * kUnknownVariance;

@@ -29,9 +29,11 @@
 #include "localizer/curb_features.hpp"
 #include "localizer/deskew.hpp"
 #include "localizer/gicp_matcher.hpp"
+#include "localizer/gps_step_detector.hpp"
 #include "localizer/hd_map.hpp"
 #include "localizer/intensity_calibration.hpp"
 #include "localizer/localizer_params.hpp"
+#include "localizer/lost_detector.hpp"
 
 namespace lidarloop {
 
@@ -54,8 +56,11 @@ enum HealthFlag : uint32_t {
   // The pose is not to be trusted: the filter has not converged since a cold start, or the observations
   // stopped agreeing with it. The localizer is relocalizing (a wide search) until they agree again.
   kLost = 1u << 14,
+  // A GPS fix stepped away from the receiver's usual level and the map sided with the filter: the fixes
+  // are not used until they step back (a multipath jump ends).
+  kGpsRejected = 1u << 15,
 };
-constexpr int kHealthFlagCount = 15;
+constexpr int kHealthFlagCount = 16;
 // "ok", or the set flags as words: "no GPS, few curbs".
 std::string describe_health(uint32_t flags);
 
@@ -166,7 +171,16 @@ class Localizer {
   bool pose_known_to_calibrate() const;
   void calibrate_lasers_to_each_other(const ScanPoints& points, const std::vector<size_t>& ground);
   void calibrate_lasers_to_the_map(const ScanPoints& points, const std::vector<size_t>& ground);
-  void report_pose(LocalizerEstimate& e) const;
+  // While lost: the wide search (relocalization) with this scan's S; the filter moves to what it finds.
+  void relocalize(IntensityGrid& S, LocalizerEstimate& e);
+  // The filter admits the doubt that made it lost: its spread grows to cover where the refused
+  // observations put the car, so the wide search's window (and a bound) covers it.
+  void widen_to(const std::deque<Disagreement>& refused);
+  void disagree(const Eigen::Vector2d& innovation, double reach_m);
+  // A map match the filter took (updated from `prior`), pinning down these axes of the car.
+  void agree(const Pose2d& prior, bool along, bool across);
+  double position_sigma() const;  // the filter's, largest axis
+  void report_pose(LocalizerEstimate& e);
   // The chi^2 gate, with the filter's doubt growing after max_rejections in a row (see
   // HealthParams); true: use the observation.
   bool gate(double mahalanobis_sq, double threshold, int& rejections);
@@ -192,6 +206,14 @@ class Localizer {
   Eigen::Isometry3d last_registration_ = Eigen::Isometry3d::Identity();
   IntensityCalibration intensity_calibration_;
   ScanFeatures features_;
+
+  LostDetector lost_;
+  GpsStepDetector gps_steps_;
+  bool gps_stepped_ = false;  // the GPS's disagreement that made the localizer lost was a step
+  // Set while the GPS is rejected (kGpsRejected): the innovation level it had before it jumped.
+  std::optional<Eigen::Vector2d> gps_fault_level_;
+  std::optional<Pose2d> pose_when_lost_;
+  std::optional<Eigen::Vector2d> last_gps_step_;  // the innovation of the last fix that stepped
 };
 
 }  // namespace lidarloop

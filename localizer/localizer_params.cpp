@@ -252,7 +252,8 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("position_per_sqrt_s", p.filter.position_per_sqrt_s, 0.0, 10.0)
       .done();
   YamlMap(y, top["curb_noise"], "curb_noise")
-      .number("point_sigma_m", p.curb_noise.point_sigma_m, 1e-4, 10.0)
+      .number("min_point_sigma_m", p.curb_noise.min_point_sigma_m, 1e-4, 10.0)
+      .number("correlation_length_m", p.curb_noise.correlation_length_m, 0.01, 100.0)
       .number("inlier_distance_m", p.curb_noise.inlier_distance_m, 0.01, 100.0)
       .number("min_sigma_m", p.curb_noise.min_sigma_m, 0.0, 10.0)
       .number("min_sigma_yaw_rad", p.curb_noise.min_sigma_yaw_rad, 0.0, 1.0)
@@ -271,9 +272,30 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("min_inlier_ratio", p.health.min_inlier_ratio, 0.0, 1.0)
       .number("gate_curb", p.health.gate_curb, 0.0, 1e9)
       .number("gate_intensity", p.health.gate_intensity, 0.0, 1e9)
+      .number("gate_gps", p.health.gate_gps, 0.0, 1e9)
       .integer("max_rejections", p.health.max_rejections, 0, 1000000)
       .number("max_inflated_sigma_m", p.health.max_inflated_sigma_m, 0.0, 1000.0)
       .done();
+  YamlMap(y, top["gps_steps"], "gps_steps")
+      .number("level_tau_s", p.gps_steps.level_tau_s, 0.01, 1e4)
+      .number("min_noise_sigma_m", p.gps_steps.min_noise_sigma_m, 0.001, 100.0)
+      .number("step_gate", p.gps_steps.step_gate, 0.1, 1e6)
+      .done();
+  YamlMap(y, top["lost"], "lost")
+      .number("window_s", p.lost.window_s, 0.01, 100.0)
+      .integer("min_disagreements", p.lost.min_disagreements, 1, 1000)
+      .integer("confirmations", p.lost.confirmations, 1, 1000)
+      .number("converged_sigma_m", p.lost.converged_sigma_m, 0.001, 100.0)
+      .done();
+  YamlMap(y, top["relocalization"], "relocalization")
+      .number("window_sigmas", p.relocalization.window_sigmas, 0.1, 100.0)
+      .number("lost_offset_sigmas", p.relocalization.lost_offset_sigmas, 0.1, 100.0)
+      .number("min_range_m", p.relocalization.min_range_m, 0.0, 100.0)
+      .number("max_longitudinal_m", p.relocalization.max_longitudinal_m, 0.0, 100.0)
+      .number("max_lateral_m", p.relocalization.max_lateral_m, 0.0, 100.0)
+      .number("lost_yaw_sigma_deg", p.relocalization.lost_yaw_sigma_deg, 0.0, 90.0)
+      .done();
+  YamlMap(y, top["integrity"], "integrity").number("probability", p.integrity.probability, 0.5, 1.0 - 1e-12).done();
   top.done();
 }
 

@@ -17,10 +17,13 @@
 #include "localizer/driving_corridor.hpp"
 #include "localizer/fmt_matcher.hpp"
 #include "localizer/gicp_matcher.hpp"
+#include "localizer/gps_step_detector.hpp"
 #include "localizer/intensity_calibration.hpp"
+#include "localizer/lost_detector.hpp"
 #include "localizer/obstacle_rejection.hpp"
 #include "localizer/pose_filter.hpp"
 #include "localizer/probabilistic_icp.hpp"
+#include "localizer/protection_bound.hpp"
 
 namespace lidarloop {
 
@@ -40,8 +43,24 @@ struct HealthParams {
   // every further rejection, up to max_inflated_sigma_m: if the filter is what went wrong, the gate
   // then opens to the map; a matcher that has run off (tens of metres) stays locked out.
   double gate_curb = 16.27, gate_intensity = 13.82;
+  // A GPS fix against the receiver's own variance (not the scaled one): chi^2, 2 dof, 99.9 %.
+  double gate_gps = 13.82;
   int max_rejections = 10;
   double max_inflated_sigma_m = 2.0;
+};
+
+// The wide search while lost (beyond the paper). Its window is the filter's spread, which on becoming
+// lost grows to cover where the refused observations put the car, within these bounds.
+struct RelocalizationParams {
+  double window_sigmas = 3.0;
+  // The farthest refused observation's offset counts as this many sigmas of the lost filter's spread:
+  // the window then reaches half as far again beyond it, and the truth is not at its edge.
+  double lost_offset_sigmas = 2.0;
+  double min_range_m = 2.0;  // half extent on each axis, at least
+  double max_longitudinal_m = 8.0, max_lateral_m = 6.0;
+  // The heading doubt a lost filter admits (1 sigma, deg): the paper's receiver's heading error
+  // (1.5-2 deg), which is all a cold start or a kidnapped filter can vouch for.
+  double lost_yaw_sigma_deg = 1.5;
 };
 
 struct GpsNoise {
@@ -117,6 +136,10 @@ struct LocalizerParams {
   CurbMatchNoise curb_noise;
   GpsNoise gps_noise;
   HealthParams health;
+  GpsStepParams gps_steps;
+  LostParams lost;
+  RelocalizationParams relocalization;
+  IntegrityParams integrity;
 };
 
 // A method as scenarios and the command line give it: a built-in name, or "exec:PROGRAM ARGS" (words

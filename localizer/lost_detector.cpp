@@ -1,0 +1,45 @@
+#include "localizer/lost_detector.hpp"
+
+#include "common/units.hpp"
+
+namespace lidarloop {
+
+void LostDetector::start_search() {
+  lost_ = true;
+  found_ = false;
+  agreements_along_ = agreements_across_ = 0;
+}
+
+void LostDetector::disagree(const Disagreement& d) {
+  disagreements(d.stamp_ns);
+  recent_.push_back(d);
+  agreements_along_ = agreements_across_ = 0;
+  if (int(recent_.size()) >= p_.min_disagreements) start_search();
+}
+
+void LostDetector::agree(bool along, bool across, double position_sigma_m) {
+  if (!lost_) return;
+  agreements_along_ += along;
+  agreements_across_ += across;
+  // Confirmed: a found pose that enough matches agree with, or a cold start the narrow matchers
+  // converged on their own.
+  const bool agreed = agreements_along_ >= p_.confirmations && agreements_across_ >= p_.confirmations;
+  if (agreed && (found_ || position_sigma_m <= p_.converged_sigma_m)) {
+    lost_ = found_ = false;
+    agreements_along_ = agreements_across_ = 0;
+  }
+}
+
+void LostDetector::found() {
+  found_ = true;
+  agreements_along_ = agreements_across_ = 0;
+  recent_.clear();
+}
+
+const std::deque<Disagreement>& LostDetector::disagreements(int64_t t_ns) {
+  const int64_t window_ns = int64_t(p_.window_s * kNsPerS);
+  while (!recent_.empty() && recent_.front().stamp_ns < t_ns - window_ns) recent_.pop_front();
+  return recent_;
+}
+
+}  // namespace lidarloop
