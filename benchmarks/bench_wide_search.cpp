@@ -5,11 +5,12 @@
 // - BM_WideApsStep: WideApsSearch run to the end on one S, one step per iteration of its loop; the
 //   counters give the steps a search takes and the slowest step (ms).
 // - BM_WideApsOneShot: the whole search in one call, for comparison.
-// - BM_CurbHypotheses: the grid of ICP starts on a scan's worth of curbs at a city block.
+// - BM_CurbHypothesesStep, BM_CurbHypothesesOneShot: the grid of ICP starts on a scan's worth of curbs
+//   at a city block, spread over steps and in one call.
 // S is Table I's 200 x 200 cells of 0.2 m, usable over a 12 m wide road the length of the grid (the
 // corridor's ground), over a map of irregular paint.
 #include <algorithm>
-#include <chrono>
+#include <ctime>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -91,25 +92,39 @@ IntensityGrid road_grid() {
   return build_intensity_grid(points, values, prior, g);
 }
 
+// This thread's CPU time (ms): on a shared machine wall time counts other processes' turns too.
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * double(t.tv_sec) + 1e-6 * double(t.tv_nsec);
+}
+
 void BM_WideApsStep(benchmark::State& state) {
   IntensityMap map(map_dir());
   const IntensityGrid S = road_grid();
   WideApsSearch search;
   int steps = 0, searches = 0;
+  std::vector<double> step_ms;  // CPU time of each step of one search, summed over searches
   double slowest_ms = 0;
   for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
+    const double start = thread_cpu_ms();
     search.step(S, map);
-    slowest_ms = std::max(slowest_ms, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    const double ms = thread_cpu_ms() - start;
+    slowest_ms = std::max(slowest_ms, ms);
+    if (step_ms.size() <= size_t(steps)) step_ms.push_back(0);
+    step_ms[size_t(steps)] += ms;
     ++steps;
     if (search.done()) {
       benchmark::DoNotOptimize(search.result().pose.x);
       ++searches;
+      steps = 0;
       search.restart();
     }
   }
-  state.counters["steps_per_search"] = searches ? double(steps) / searches : 0.0;
-  state.counters["slowest_step_ms"] = slowest_ms;
+  state.counters["steps_per_search"] = double(step_ms.size());
+  state.counters["slowest_step_cpu_ms"] = slowest_ms;
+  for (size_t k = 0; k < step_ms.size() && searches > 0; ++k)
+    state.counters["step" + std::to_string(k) + "_cpu_ms"] = step_ms[k] / searches;
 }
 BENCHMARK(BM_WideApsStep)->Unit(benchmark::kMillisecond);
 
@@ -126,7 +141,13 @@ BENCHMARK(BM_WideApsOneShot)->Unit(benchmark::kMillisecond);
 
 // Streets every 40 m both ways, curbs 5 m either side of each centre line, points 0.1 m apart (as
 // bench_curb_matching's city blocks); ~110 features (the campus drive's) seen from a pose 2.5 m off.
-void BM_CurbHypotheses(benchmark::State& state) {
+struct CityBlock {
+  MapIndex index;
+  Pose2d prior;
+  std::vector<Eigen::Vector2d> features;
+};
+
+CityBlock city_block() {
   constexpr double kWindow = 32, kBlock = 40, kHalfWidth = 5, kSpacing = 0.1, kRange = 20;
   constexpr size_t kFeatures = 110;
   std::vector<Eigen::Vector2d> curbs;
@@ -136,7 +157,6 @@ void BM_CurbHypotheses(benchmark::State& state) {
         curbs.emplace_back(t, centre + side);
         curbs.emplace_back(centre + side, t);
       }
-  const MapIndex index(curbs);
   const Pose2d truth{-12.0, 3.0, 0.0};
   const Pose2d prior = truth.compose(Pose2d{1.0, 2.5, 2.0 * kDeg}.inverse());
   std::vector<Eigen::Vector2d> near;
@@ -145,12 +165,40 @@ void BM_CurbHypotheses(benchmark::State& state) {
   std::vector<Eigen::Vector2d> features;
   for (size_t k = 0; k < kFeatures; ++k)
     features.push_back(prior.apply(truth.inverse().apply(near[k * near.size() / kFeatures])));
+  return {MapIndex(curbs), prior, features};
+}
+
+void BM_CurbHypothesesOneShot(benchmark::State& state) {
+  const CityBlock c = city_block();
   CurbHypothesesResult r;
-  for (auto _ : state) benchmark::DoNotOptimize((r = curb_hypotheses(features, index, prior)).best.pose.x);
+  for (auto _ : state) benchmark::DoNotOptimize((r = curb_hypotheses(c.features, c.index, c.prior)).best.pose.x);
   state.counters["icp_runs"] = r.icp_runs;
   state.counters["places"] = double(r.places.size());
 }
-BENCHMARK(BM_CurbHypotheses)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CurbHypothesesOneShot)->Unit(benchmark::kMillisecond);
+
+// CurbHypothesisSearch run to the end, one step per iteration: the steps a search takes and the
+// slowest step's CPU time (ms).
+void BM_CurbHypothesesStep(benchmark::State& state) {
+  const CityBlock c = city_block();
+  CurbHypothesisSearch search;
+  int steps = 0, searches = 0;
+  double slowest_ms = 0;
+  for (auto _ : state) {
+    const double start = thread_cpu_ms();
+    search.step(c.features, c.index, c.prior);
+    slowest_ms = std::max(slowest_ms, thread_cpu_ms() - start);
+    ++steps;
+    if (search.done()) {
+      benchmark::DoNotOptimize(search.result().best.pose.x);
+      ++searches;
+      search.restart();
+    }
+  }
+  state.counters["steps_per_search"] = searches ? double(steps) / searches : 0.0;
+  state.counters["slowest_step_cpu_ms"] = slowest_ms;
+}
+BENCHMARK(BM_CurbHypothesesStep)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace lidarloop

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace lidarloop {
@@ -34,20 +35,6 @@ std::vector<double> steps(double range, double step) {
   return v;
 }
 
-// The starting corrections: the grid over the window in the prior's vehicle frame, thinned evenly to
-// at most max_starts.
-std::vector<Pose2d> starts(const Pose2d& prior, const CurbHypothesesParams& p) {
-  std::vector<Pose2d> grid;
-  for (double yaw : steps(p.yaw_range_rad, p.yaw_step_rad))
-    for (double y : steps(p.lateral_range_m, p.lateral_step_m))
-      for (double x : steps(p.longitudinal_range_m, p.longitudinal_step_m))
-        grid.push_back(prior.compose(Pose2d{x, y, yaw}).compose(prior.inverse()));
-  if (grid.size() <= size_t(p.max_starts)) return grid;
-  std::vector<Pose2d> thinned;
-  for (size_t k = 0; k < size_t(p.max_starts); ++k) thinned.push_back(grid[k * grid.size() / size_t(p.max_starts)]);
-  return thinned;
-}
-
 // How well the features moved by `correction` lie on the map's curbs.
 CurbHypothesis scored(const std::vector<Eigen::Vector2d>& features, const MapIndex& map, const Pose2d& prior,
                       const Pose2d& correction, double inlier_distance) {
@@ -70,31 +57,43 @@ CurbHypothesis scored(const std::vector<Eigen::Vector2d>& features, const MapInd
   return h;
 }
 
-}  // namespace
+// The ICP starting corrections: the grid over the window in the prior's vehicle frame, as offsets
+// (the corrections of a step's prior are made from them), thinned evenly to at most max_starts.
+std::vector<Pose2d> start_offsets(const CurbHypothesesParams& p) {
+  std::vector<Pose2d> grid;
+  for (double yaw : steps(p.yaw_range_rad, p.yaw_step_rad))
+    for (double y : steps(p.lateral_range_m, p.lateral_step_m))
+      for (double x : steps(p.longitudinal_range_m, p.longitudinal_step_m)) grid.push_back({x, y, yaw});
+  if (grid.size() <= size_t(p.max_starts)) return grid;
+  std::vector<Pose2d> thinned;
+  for (size_t k = 0; k < size_t(p.max_starts); ++k) thinned.push_back(grid[k * grid.size() / size_t(p.max_starts)]);
+  return thinned;
+}
 
-CurbHypothesesResult curb_hypotheses(const std::vector<Eigen::Vector2d>& features_world, const MapIndex& map,
-                                     const Pose2d& prior, const CurbHypothesesParams& params) {
-  check_params(params);
-  CurbHypothesesResult result;
-  if (features_world.size() < size_t(std::max(params.min_curbs, 1)) || map.empty()) return result;
-
-  // ICP's cost is per curb: a subset spread evenly over the features keeps it bounded; every curb
-  // scores the places.
+// ICP's cost is per curb: a subset spread evenly over the features keeps it bounded; every curb scores
+// the places.
+std::vector<Eigen::Vector2d> icp_subset(const std::vector<Eigen::Vector2d>& features, int max_curbs) {
   std::vector<Eigen::Vector2d> subset;
-  const size_t n = std::min(features_world.size(), size_t(params.max_icp_curbs));
-  for (size_t k = 0; k < n; ++k) subset.push_back(features_world[k * features_world.size() / n]);
+  const size_t n = std::min(features.size(), size_t(max_curbs));
+  for (size_t k = 0; k < n; ++k) subset.push_back(features[k * features.size() / n]);
+  return subset;
+}
+
+// Every converged correction scored on the features at `prior`, clustered into places, and the
+// ambiguity of the best.
+CurbHypothesesResult places(const std::vector<Pose2d>& converged, const std::vector<Eigen::Vector2d>& features_world,
+                            const MapIndex& map, const Pose2d& prior, const CurbHypothesesParams& params) {
+  CurbHypothesesResult result;
   std::vector<CurbHypothesis> solutions;
-  for (const Pose2d& start : starts(prior, params)) {
-    const IcpResult r = icp(map, subset, start, params.icp);
-    ++result.icp_runs;
+  for (const Pose2d& t : converged) {
     // A solution outside the window (a step's reach beyond it) is another place than the one searched
     // for: at a junction, the cross street turned by 90 degrees.
-    const Pose2d d = relative(prior, r.t.compose(prior));
+    const Pose2d d = relative(prior, t.compose(prior));
     if (std::fabs(d.x) > params.longitudinal_range_m + params.longitudinal_step_m ||
         std::fabs(d.y) > params.lateral_range_m + params.lateral_step_m ||
         std::fabs(d.yaw) > params.yaw_range_rad + params.yaw_step_rad)
       continue;
-    solutions.push_back(scored(features_world, map, prior, r.t, params.inlier_distance_m));
+    solutions.push_back(scored(features_world, map, prior, t, params.inlier_distance_m));
   }
   // Greedy clustering, best first: a solution joins the first place within the cluster's size.
   std::stable_sort(solutions.begin(), solutions.end(),
@@ -113,20 +112,53 @@ CurbHypothesesResult curb_hypotheses(const std::vector<Eigen::Vector2d>& feature
     result.places.back().starts = 1;
   }
   if (result.places.empty()) return result;
-
   result.ok = true;
   result.best = result.places.front();
   if (result.places.size() > 1) result.score_margin = result.best.score - result.places[1].score;
   for (const CurbHypothesis& c : result.places) {
     if (c.score < result.best.score - params.ambiguity_score) break;  // sorted: the rest fit worse
-    const Pose2d a = relative(prior, result.best.pose), b = relative(prior, c.pose);
-    const Eigen::Vector3d d(b.x - a.x, b.y - a.y, wrap_angle(b.yaw - a.yaw));
-    result.spread = result.spread.cwiseMax(d.cwiseAbs());
+    const Pose2d d = relative(result.best.pose, c.pose);
+    result.spread = result.spread.cwiseMax(Eigen::Vector3d(d.x, d.y, d.yaw).cwiseAbs());
   }
   result.ambiguous_longitudinal = result.spread.x() > params.cluster_radius_m;
   result.ambiguous_lateral = result.spread.y() > params.cluster_radius_m;
   result.ambiguous_yaw = result.spread.z() > params.cluster_yaw_rad;
   return result;
+}
+
+}  // namespace
+
+CurbHypothesisSearch::CurbHypothesisSearch(const CurbHypothesesParams& params) : params_(params) {
+  check_params(params_);
+  if (params_.max_icp_runs_per_step < 1)
+    throw std::invalid_argument("curb_hypotheses: max_icp_runs_per_step must be >= 1");
+}
+
+void CurbHypothesisSearch::restart() { *this = CurbHypothesisSearch(params_); }
+
+void CurbHypothesisSearch::step(const std::vector<Eigen::Vector2d>& features_world, const MapIndex& map,
+                                const Pose2d& prior) {
+  if (done_ || features_world.size() < size_t(std::max(params_.min_curbs, 1)) || map.empty()) return;
+  const std::vector<Pose2d> offsets = start_offsets(params_);
+  const std::vector<Eigen::Vector2d> subset = icp_subset(features_world, params_.max_icp_curbs);
+  for (int run = 0; run < params_.max_icp_runs_per_step && next_start_ < offsets.size(); ++run) {
+    const Pose2d start = prior.compose(offsets[next_start_++]).compose(prior.inverse());
+    converged_.push_back(icp(map, subset, start, params_.icp).t);
+    ++icp_runs_;
+  }
+  if (next_start_ < offsets.size()) return;
+  done_ = true;
+  result_ = places(converged_, features_world, map, prior, params_);
+  result_.icp_runs = icp_runs_;
+}
+
+CurbHypothesesResult curb_hypotheses(const std::vector<Eigen::Vector2d>& features_world, const MapIndex& map,
+                                     const Pose2d& prior, const CurbHypothesesParams& params) {
+  CurbHypothesesParams unlimited = params;
+  unlimited.max_icp_runs_per_step = std::numeric_limits<int>::max();
+  CurbHypothesisSearch search(unlimited);
+  search.step(features_world, map, prior);
+  return search.result();
 }
 
 }  // namespace lidarloop

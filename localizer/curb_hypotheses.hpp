@@ -7,8 +7,12 @@
 // two straight curbs fix the lateral position and the heading but nothing along the road, so the
 // caller can take only the lateral and yaw part.
 //
-// Cost: one ICP run is ~10 iterations of a nearest-neighbour query per curb (MapIndex's buckets); the
-// default grid is 7 x 7 x 3 starts, and max_starts bounds it (bench_wide_search measures a call).
+// Cost: one ICP run is up to 20 iterations of a nearest-neighbour query per curb within a 2 m gate
+// (MapIndex's buckets), ~0.1-0.2 ms on 50 curbs; the default grid is 7 x 7 x 3 = 147 starts, 15-25 ms
+// in all, too much for one scan beside the localizer's 5-10 ms. CurbHypothesisSearch spreads the
+// starts over scans, max_icp_runs_per_step at a time, keeping what converged as corrections of the
+// prior (valid while the prior moves with odometry) and scoring every place on the last scan's curbs
+// (bench_wide_search measures a step and the whole search).
 #include <cstdint>
 #include <numbers>
 #include <vector>
@@ -45,6 +49,8 @@ struct CurbHypothesesParams {
   double ambiguity_score = 0.05;
   // At most this many ICP runs (the grid is thinned evenly beyond it).
   int max_starts = 160;
+  // ICP runs per CurbHypothesisSearch::step: ~4 ms (bench_wide_search), five steps for the grid.
+  int max_icp_runs_per_step = 32;
   // ICP runs on at most this many curbs (spread evenly over the features); all of them score the
   // places. 50 curbs along 40 m of two curbs are one every 1.6 m, enough to pin a transform.
   int max_icp_curbs = 50;
@@ -70,7 +76,9 @@ struct CurbHypothesesResult {
   // none.
   double score_margin = 1;
   // How far the places that fit as well as the best (within ambiguity_score) reach from it on each axis
-  // of the prior's vehicle frame: (longitudinal m, lateral m, yaw rad).
+  // of the best's vehicle frame: (longitudinal m, lateral m, yaw rad). The best's frame, not the
+  // prior's: along a straight road the places line up with the road, and in a frame turned by the
+  // prior's few degrees of error their spread along it would show as a lateral one.
   Eigen::Vector3d spread = Eigen::Vector3d::Zero();
   // Whether that reach exceeds the cluster size: the curbs do not fix this axis, the caller must not
   // use it. A straight road: longitudinal only.
@@ -78,9 +86,32 @@ struct CurbHypothesesResult {
   int icp_runs = 0;
 };
 
-// features_world: the curb features placed at `prior` (world = local frame); map: the map's curbs
-// around the prior. Deterministic. Throws std::invalid_argument for a parameter out of range.
+// The search in one go (CurbHypothesisSearch without a limit per step). features_world: the curb
+// features placed at `prior` (world = local frame); map: the map's curbs around the prior.
+// Deterministic. Throws std::invalid_argument for a parameter out of range.
 CurbHypothesesResult curb_hypotheses(const std::vector<Eigen::Vector2d>& features_world, const MapIndex& map,
                                      const Pose2d& prior, const CurbHypothesesParams& params = {});
+
+// The same search spread over scans: each step takes the newest features, placed at the newest prior,
+// and runs the next max_icp_runs_per_step starts of the grid (the grid is relative to each step's
+// prior). Once all have run, every place found is scored on the last step's features.
+class CurbHypothesisSearch {
+ public:
+  explicit CurbHypothesisSearch(const CurbHypothesesParams& params = {});
+  // One share of the search; nothing once done(). Fewer than min_curbs features: the step does nothing.
+  void step(const std::vector<Eigen::Vector2d>& features_world, const MapIndex& map, const Pose2d& prior);
+  bool done() const { return done_; }
+  // The result at the last step's prior; ok = false until done().
+  const CurbHypothesesResult& result() const { return result_; }
+  void restart();
+
+ private:
+  CurbHypothesesParams params_;
+  size_t next_start_ = 0;
+  std::vector<Pose2d> converged_;  // ICP's corrections of the prior, one per start run
+  int icp_runs_ = 0;
+  bool done_ = false;
+  CurbHypothesesResult result_;
+};
 
 }  // namespace lidarloop

@@ -51,7 +51,7 @@ struct WideApsParams {
   double fine_yaw_step_rad = 0.25 * std::numbers::pi / 180.0;
   // Refinement window, +- this many fine cells around a coarse candidate: one coarse cell, where the
   // fine peak can be when the coarse one is right.
-  int refine_radius_cells = 4;
+  int refine_radius_cells = 3;
   // Coarse peaks refined (top k, pairwise farther apart than distinct_separation_m).
   int candidates = 4;
   // Two peaks closer than this are one (m). Above the refinement's reach (0.8 m) and below the period
@@ -61,10 +61,11 @@ struct WideApsParams {
   // A search made of fewer usable coarse cells than this says nothing (ok = false); aps.min_cells
   // applies to the fine level.
   int min_coarse_cells = 10;
-  // Work per WideApsSearch::step, in z-score terms of Eq. 14 (one cell at one offset): about 1 ns each
-  // on one core (bench_wide_search), so the default is ~3-4 ms beside the map reads. A unit is never
-  // split: a call does at least one.
-  int64_t max_terms_per_step = 4'000'000;
+  // Work per WideApsSearch::step, in z-score terms of Eq. 14 (one cell of S at one pose). The coarse
+  // phase is ~1.5 M terms and each refinement ~2.3 M for Table I's S over a 12 m wide road, so the
+  // default runs one of them per step: 3-5 ms on one core with the map reads (bench_wide_search), five
+  // steps in all. A unit is never split: a step does at least one.
+  int64_t max_terms_per_step = 2'500'000;
 };
 
 struct WideApsResult {

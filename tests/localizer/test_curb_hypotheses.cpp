@@ -103,6 +103,33 @@ TEST(CurbHypotheses, JunctionRecoversTheLongitudinalToo) {
   EXPECT_GT(c.result.best.inlier_ratio, 0.9);
 }
 
+TEST(CurbHypotheses, SpreadOverStepsGivesTheOneShotAnswer) {
+  const std::vector<Eigen::Vector2d> curbs = road(true);
+  const MapIndex index(curbs);
+  const Pose2d truth{1.0, -0.8, 0.0}, prior = truth.compose(Pose2d{3.0, 2.5, 2.0 * kDeg}.inverse());
+  const auto features = features_at(curbs, truth, prior, 2);
+  const CurbHypothesesResult once = curb_hypotheses(features, index, prior);
+  CurbHypothesesParams p;
+  p.max_icp_runs_per_step = 10;
+  CurbHypothesisSearch search(p);
+  int steps = 0;
+  while (!search.done() && steps < 100) {
+    EXPECT_FALSE(search.result().ok);
+    search.step(features, index, prior);
+    ++steps;
+  }
+  ASSERT_TRUE(search.done());
+  EXPECT_EQ(steps, (once.icp_runs + 9) / 10);
+  const CurbHypothesesResult& r = search.result();
+  ASSERT_TRUE(r.ok);
+  EXPECT_DOUBLE_EQ(r.best.pose.x, once.best.pose.x);
+  EXPECT_DOUBLE_EQ(r.best.pose.y, once.best.pose.y);
+  EXPECT_DOUBLE_EQ(r.best.score, once.best.score);
+  EXPECT_EQ(r.places.size(), once.places.size());
+  search.restart();
+  EXPECT_FALSE(search.done());
+}
+
 TEST(CurbHypotheses, TooFewCurbsOrBadParametersGiveNoAnswer) {
   const MapIndex index(road(false));
   const std::vector<Eigen::Vector2d> few{{0, 5}, {1, 5}};
