@@ -10,8 +10,8 @@
 // S is Table I's 200 x 200 cells of 0.2 m, usable over a 12 m wide road the length of the grid (the
 // corridor's ground), over a map of irregular paint.
 #include <algorithm>
-#include <ctime>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <numbers>
 #include <random>
@@ -32,7 +32,7 @@ namespace fs = std::filesystem;
 constexpr double kResolution = 0.2;  // the map's cells (Table I scale)
 constexpr double kMapHalf = 50.0;    // m: S's 28 m reach, the search's 6 m and more
 constexpr double kRoadHalfWidth = 6.0;
-constexpr int kSamplesPerCell = 6;  // points per cell of the map and of S: above n_e = 3
+constexpr int kSamplesPerCell = 6;                       // points per cell of the map and of S: above n_e = 3
 constexpr double kPaint = 35, kAsphalt = 6, kNoise = 2;  // intensity counts
 constexpr double kDeg = std::numbers::pi / 180.0;
 
@@ -84,7 +84,8 @@ IntensityGrid road_grid() {
   for (int r = 0; r < g.height_cells; ++r)
     for (int c = 0; c < g.width_cells; ++c)
       for (int k = 0; k < kSamplesPerCell; ++k) {
-        const Eigen::Vector2d v((c + 0.5 - 0.5 * g.width_cells) * g.cell_m, (r + 0.5 - 0.5 * g.height_cells) * g.cell_m);
+        const Eigen::Vector2d v((c + 0.5 - 0.5 * g.width_cells) * g.cell_m,
+                                (r + 0.5 - 0.5 * g.height_cells) * g.cell_m);
         if (std::fabs(v.y()) > kRoadHalfWidth) continue;
         points.emplace_back(v.x(), v.y(), 0.0);
         values.push_back(intensity(truth.apply(v), rng));

@@ -24,7 +24,8 @@ void check_params(const CurbHypothesesParams& p) {
   if (!positive(p.inlier_distance_m) || !finite_non_negative(p.cluster_radius_m) ||
       !finite_non_negative(p.cluster_yaw_rad) || !finite_non_negative(p.ambiguity_score))
     throw std::invalid_argument("curb_hypotheses: inlier distance, cluster sizes and ambiguity must be >= 0");
-  if (p.max_starts < 1 || p.max_icp_curbs < 1) throw std::invalid_argument("curb_hypotheses: max_starts and max_icp_curbs must be >= 1");
+  if (p.max_starts < 1 || p.max_icp_curbs < 1)
+    throw std::invalid_argument("curb_hypotheses: max_starts and max_icp_curbs must be >= 1");
 }
 
 // -n..n steps of `step` within +-range.

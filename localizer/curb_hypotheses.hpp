@@ -58,8 +58,8 @@ struct CurbHypothesesParams {
 };
 
 struct CurbHypothesis {
-  Pose2d correction;  // pose = correction.compose(prior): ICP's transform of the world-frame features
-  Pose2d pose;        // local frame
+  Pose2d correction;           // pose = correction.compose(prior): ICP's transform of the world-frame features
+  Pose2d pose;                 // local frame
   double inlier_ratio = 0;     // curbs within inlier_distance_m of the map
   double mean_residual_m = 0;  // over those
   // inlier_ratio discounted by the inliers' mean squared residual over inlier_distance_m^2: the mean

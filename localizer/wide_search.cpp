@@ -49,8 +49,7 @@ void check_params(const WideApsParams& p) {
 
 void check_grid(const IntensityGrid& S, double map_resolution_m, const WideApsParams& p) {
   const IntensityGridParams& g = S.params;
-  if (g.width_cells <= 0 || g.height_cells <= 0 ||
-      S.cells.size() != size_t(g.width_cells) * size_t(g.height_cells))
+  if (g.width_cells <= 0 || g.height_cells <= 0 || S.cells.size() != size_t(g.width_cells) * size_t(g.height_cells))
     throw std::invalid_argument("wide_aps_search: grid S has no cells or not w_s * h_s of them");
   if (!(std::fabs(g.cell_m - map_resolution_m) <= 1e-6 * map_resolution_m))
     throw std::invalid_argument("wide_aps_search: grid cell size " + std::to_string(g.cell_m) +
@@ -277,7 +276,8 @@ CoarseS coarse_s_at(const Level& C, double yaw, const OffsetBox& box, double min
       const IntensityMoments& m = merged[C.index(col, row)];
       if (m.count == 0) continue;
       const bool on_map = col + box.i0 >= 0 && row + box.j0 >= 0 && col + box.i0 + box.ni <= C.cols &&
-                          row + box.j0 + box.nj <= C.rows && C.missing.in(col + box.i0, row + box.j0, box.ni, box.nj) == 0;
+                          row + box.j0 + box.nj <= C.rows &&
+                          C.missing.in(col + box.i0, row + box.j0, box.ni, box.nj) == 0;
       out.cells.push_back({0, 0, float(m.mean), float(aps_cell_sigma(m.to_cell(), min_sigma))});
       out.placements.zero.push_back(C.index(col, row));
       out.placements.takes_part.push_back(on_map ? 1 : 0);
@@ -450,10 +450,9 @@ void refine(WideApsCandidate& cand, const IntensityGrid& S, IntensityMap& map, c
 // The best refined candidate, and the best farther than distinct_separation_m from it, at `prior`.
 void summarise(const std::vector<WideApsCandidate>& refined, const Pose2d& prior, const WideApsParams& p,
                double coarse_m, WideApsResult& r) {
-  const auto best = std::max_element(refined.begin(), refined.end(),
-                                     [](const WideApsCandidate& a, const WideApsCandidate& b) {
-                                       return a.log_p_per_cell < b.log_p_per_cell;
-                                     });
+  const auto best = std::max_element(
+      refined.begin(), refined.end(),
+      [](const WideApsCandidate& a, const WideApsCandidate& b) { return a.log_p_per_cell < b.log_p_per_cell; });
   if (best == refined.end() || !std::isfinite(best->log_p_per_cell)) return;
   const Pose2d pose = best->correction.compose(prior);
   const WideApsCandidate* runner_up = nullptr;

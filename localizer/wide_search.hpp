@@ -123,7 +123,7 @@ class WideApsSearch {
   enum class Phase { coarse, fine, done };
   WideApsParams params_;
   Phase phase_ = Phase::coarse;
-  int next_unit_ = 0;                // yaw slice (coarse) or candidate (fine)
+  int next_unit_ = 0;                      // yaw slice (coarse) or candidate (fine)
   std::vector<WideApsCandidate> pool_;     // coarse local maxima so far
   std::vector<WideApsCandidate> refined_;  // the distinct best of the pool, refined in the fine phase
   WideApsResult result_;

@@ -16,10 +16,10 @@ namespace lidarloop {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kSpacing = 0.1;       // m between map curb points (CurbLayer's default)
-constexpr double kHalfWidth = 5.0;     // m from the centre line to each curb
-constexpr double kMapHalf = 40.0;      // m of road either side of the origin
-constexpr double kSensorRange = 20.0;  // m: the curbs a scan's accumulated features reach
+constexpr double kSpacing = 0.1;        // m between map curb points (CurbLayer's default)
+constexpr double kHalfWidth = 5.0;      // m from the centre line to each curb
+constexpr double kMapHalf = 40.0;       // m of road either side of the origin
+constexpr double kSensorRange = 20.0;   // m: the curbs a scan's accumulated features reach
 constexpr double kFeatureNoise = 0.05;  // m, the detector's
 constexpr int kFeatureStride = 4;       // every 4th curb point is a feature: ~100 a scan, as on the campus drive
 
@@ -67,11 +67,12 @@ Case search(bool junction, const Pose2d& error) {
   const auto start = std::chrono::steady_clock::now();
   const CurbHypothesesResult r = curb_hypotheses(features, index, prior);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::printf("[ curbs ] %s: best (%.3f, %.3f, %.2f deg) truth (%.3f, %.3f, %.2f deg) score %.3f inliers %.2f; "
-              "%zu places, margin %.3f, spread (%.2f m, %.2f m, %.2f deg); %zu features, %d ICP runs, %.1f ms\n",
-              junction ? "junction" : "straight", r.best.pose.x, r.best.pose.y, r.best.pose.yaw / kDeg, truth.x,
-              truth.y, truth.yaw / kDeg, r.best.score, r.best.inlier_ratio, r.places.size(), r.score_margin,
-              r.spread.x(), r.spread.y(), r.spread.z() / kDeg, features.size(), r.icp_runs, ms);
+  std::printf(
+      "[ curbs ] %s: best (%.3f, %.3f, %.2f deg) truth (%.3f, %.3f, %.2f deg) score %.3f inliers %.2f; "
+      "%zu places, margin %.3f, spread (%.2f m, %.2f m, %.2f deg); %zu features, %d ICP runs, %.1f ms\n",
+      junction ? "junction" : "straight", r.best.pose.x, r.best.pose.y, r.best.pose.yaw / kDeg, truth.x, truth.y,
+      truth.yaw / kDeg, r.best.score, r.best.inlier_ratio, r.places.size(), r.score_margin, r.spread.x(), r.spread.y(),
+      r.spread.z() / kDeg, features.size(), r.icp_runs, ms);
   return {r, truth};
 }
 

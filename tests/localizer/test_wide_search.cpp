@@ -28,7 +28,7 @@ const Geodetic kCampus{31.2856, 121.2147, 4.0};
 // the sanitizers; the search does not depend on S's size.
 constexpr double kMapHalf = 24.0;
 constexpr int kSCells = 100;
-constexpr int kMapSamplesPerCell = 6;  // a mapping drive's points per cell
+constexpr int kMapSamplesPerCell = 6;   // a mapping drive's points per cell
 constexpr int kScanSamplesPerCell = 6;  // more than n_e = 3, so most cells of S take part
 constexpr double kPaint = 35, kPaintNoise = 4, kAsphalt = 6, kAsphaltNoise = 1.5;  // intensity counts
 
@@ -152,11 +152,12 @@ TEST_F(WideSearch, RecoversAKnownErrorOfMetresAndDegrees) {
   const auto start = std::chrono::steady_clock::now();
   const WideApsResult r = wide_aps_search(S, map);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::printf("[ wide ] pose (%.3f, %.3f, %.2f deg), truth (%.3f, %.3f, %.2f deg); std (%.3f, %.3f m, %.2f deg); "
-              "margin %.1f; %d cells; %lld offsets, %lld terms; %.1f ms\n",
-              r.pose.x, r.pose.y, r.pose.yaw / kDeg, kTruth.x, kTruth.y, kTruth.yaw / kDeg,
-              std::sqrt(r.covariance(0, 0)), std::sqrt(r.covariance(1, 1)), std::sqrt(r.covariance(2, 2)) / kDeg,
-              r.margin, r.cells_used, (long long)r.offsets_evaluated, (long long)r.terms_evaluated, ms);
+  std::printf(
+      "[ wide ] pose (%.3f, %.3f, %.2f deg), truth (%.3f, %.3f, %.2f deg); std (%.3f, %.3f m, %.2f deg); "
+      "margin %.1f; %d cells; %lld offsets, %lld terms; %.1f ms\n",
+      r.pose.x, r.pose.y, r.pose.yaw / kDeg, kTruth.x, kTruth.y, kTruth.yaw / kDeg, std::sqrt(r.covariance(0, 0)),
+      std::sqrt(r.covariance(1, 1)), std::sqrt(r.covariance(2, 2)) / kDeg, r.margin, r.cells_used,
+      (long long)r.offsets_evaluated, (long long)r.terms_evaluated, ms);
   ASSERT_TRUE(r.ok);
   EXPECT_LT(std::hypot(r.pose.x - kTruth.x, r.pose.y - kTruth.y), kResolution);
   EXPECT_LT(std::fabs(wrap_angle(r.pose.yaw - kTruth.yaw)), 0.5 * kDeg);
