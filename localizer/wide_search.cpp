@@ -1,8 +1,9 @@
 // Wide APS over x, y and yaw, coarse to fine. See wide_search.hpp.
 //
 // Frame: everything is scored in the vehicle frame of the step's prior (S.pose), as aps_match does: the
-// map is resampled once into a window of that frame's cells, a yaw candidate rotates S's cells about the
-// vehicle into it, and an offset is whole cells. So at yaw zero a fine score is aps_match's.
+// map is resampled into windows of that frame's cells (one for the coarse level, one around each
+// refined candidate), a yaw rotates S's cells about the vehicle into them, and an offset is whole
+// cells. So at yaw zero a fine score is aps_match's.
 #include "localizer/wide_search.hpp"
 
 #include <algorithm>
@@ -21,6 +22,8 @@ namespace {
 // Lengths and angles that must come out whole (ranges over steps) are rounded with this tolerance, so
 // a range that is a multiple of its step keeps its last step.
 constexpr double kStepTolerance = 1e-9;
+// S's cell and the map's must be one size; they come from YAML, not from one literal.
+constexpr double kLengthTolerance = 1e-6;
 
 int whole_steps(double range, double step) { return static_cast<int>(std::floor(range / step + kStepTolerance)); }
 
@@ -51,7 +54,7 @@ void check_grid(const IntensityGrid& S, double map_resolution_m, const WideApsPa
   const IntensityGridParams& g = S.params;
   if (g.width_cells <= 0 || g.height_cells <= 0 || S.cells.size() != size_t(g.width_cells) * size_t(g.height_cells))
     throw std::invalid_argument("wide_aps_search: grid S has no cells or not w_s * h_s of them");
-  if (!(std::fabs(g.cell_m - map_resolution_m) <= 1e-6 * map_resolution_m))
+  if (!(std::fabs(g.cell_m - map_resolution_m) <= kLengthTolerance * map_resolution_m))
     throw std::invalid_argument("wide_aps_search: grid cell size " + std::to_string(g.cell_m) +
                                 " m is not the map's resolution " + std::to_string(map_resolution_m) + " m");
   if (g.width_cells % p.coarse_factor != 0 || g.height_cells % p.coarse_factor != 0)
@@ -65,12 +68,12 @@ struct SourceCell {
 };
 
 // One level of the search: S's usable cells, and the map in the vehicle frame's cells of cell_m under
-// S shifted by (centre_i, centre_j) cells and by up to the margins more. Window cell (c, r) is the
-// vehicle-frame cell of S's cell (c - margin_x + centre_i, r - margin_y + centre_j).
+// S shifted by a centre offset (ci, cj) cells and by up to the margins more. Window cell (c, r) is the
+// vehicle-frame cell of S's cell (c - margin_x + ci, r - margin_y + cj); offsets are relative to the
+// centre.
 struct Level {
   double cell_m = 0;
   int s_cols = 0, s_rows = 0;
-  int centre_i = 0, centre_j = 0;
   int margin_x = 0, margin_y = 0;
   std::vector<SourceCell> cells;  // fine level: S's usable cells
   // Coarse level: S's usable fine cells (vehicle frame) with their Eq. 8 statistics, merged into
@@ -128,18 +131,16 @@ struct MapReader {
   }
 };
 
-// The fine level around a candidate at (ci, cj) cells and yaw: margins for a box of +-reach cells
-// and S rotated by up to |yaw| plus the refinement's yaws.
+// The fine level around a candidate at (ci, cj) cells: margins for boxes of +-reach cells and S
+// rotated by up to |yaw| plus the refinement's yaws.
 Level fine_level(const IntensityGrid& S, IntensityMap& map, const WideApsParams& p, int ci, int cj, double yaw,
                  int reach) {
   Level L;
   L.cell_m = S.params.cell_m;
   L.s_cols = S.params.width_cells;
   L.s_rows = S.params.height_cells;
-  L.centre_i = ci;
-  L.centre_j = cj;
   const double turn = std::fabs(yaw) + 0.5 * p.coarse_yaw_step_rad;
-  L.margin_x = L.margin_y = reach + int(std::ceil(rotation_reach(S, turn) / L.cell_m)) + 1;
+  L.margin_x = L.margin_y = reach + int(std::ceil(rotation_reach(S, turn) / L.cell_m)) + 1;  // +1: rounding
   for (int r = 0; r < L.s_rows; ++r)
     for (int c = 0; c < L.s_cols; ++c) {
       const IntensityCell& s = S.cells[size_t(r) * size_t(L.s_cols) + size_t(c)];
@@ -371,7 +372,10 @@ void refine(WideApsCandidate& cand, const IntensityGrid& S, IntensityMap& map, c
   const Pose2d b = relative(prior, cand.correction.compose(prior));  // offset and yaw, vehicle frame
   const int R = p.refine_radius_cells, K = fine_yaw_steps(p);
   const int ci = int(std::lround(b.x / S.params.cell_m)), cj = int(std::lround(b.y / S.params.cell_m));
-  const Level F = fine_level(S, map, p, ci, cj, b.yaw, 2 * R + 1);
+  // The boxes below reach 3R + 1 cells from the centre (a re-centring by R, then +-(R + 1) around the
+  // peak), at this candidate's yaws or the leading one's.
+  const double turn = std::max(std::fabs(b.yaw), lead_yaw ? std::fabs(*lead_yaw) : 0.0);
+  const Level F = fine_level(S, map, p, ci, cj, turn, 3 * R + 1);
   const double alpha = p.aps.alpha;
   // The peak of a box at yaw k of the placements: (offset i, offset j) relative to the centre.
   const auto peak = [&](const Placements& pl, size_t k, const OffsetBox& box, std::vector<double>& log_p) {

@@ -7,19 +7,23 @@
 // 61 x 61 x 33 poses times thousands of cells, about a second. The paint that decides the match is
 // still visible when S and the map are merged into 0.8 m cells (Eq. 8's statistics merged exactly, so a
 // cell half paint half asphalt has the mean and the spread of both), where the same window is 15 x 15
-// offsets at 1 deg steps on a sixteenth of the cells. The coarse level keeps the best few distinct
-// peaks; each is refined at the map's resolution in a window of one coarse cell with finer yaw steps,
-// where the scores are aps_match's own (the same alpha, min_sigma, n_e and cells-under-map rule).
+// offsets at 1 deg steps on a sixteenth of the cells (S's cells turned with each yaw and merged anew).
+// The coarse level keeps the best few distinct peaks; each is refined at the map's resolution in a
+// window of +-3 cells and then in finer yaw steps, where the scores are aps_match's own (the same alpha,
+// min_sigma, n_e and cells-under-map rule; at yaw zero the same sums).
 //
 // Budget: the localizer's scan takes 5-10 ms of a p50 8 ms / p99 20 ms budget, so the search is made of
-// small units (one yaw slice of the coarse grid, one candidate's refinement) and WideApsSearch::step
-// runs as many as a budget of z-score terms allows, resuming on the next scan. Candidates are kept as
+// units (one yaw slice of the coarse grid, one candidate's refinement) and WideApsSearch::step runs as
+// many as a budget of z-score terms allows, resuming on the next scan: 3-6 ms of CPU a step, five steps
+// (bench_wide_search; the whole search in one call is ~20 ms). Candidates are kept as
 // corrections of the prior (rigid transforms of the local frame: pose = correction * prior), which stay
-// valid while the prior moves with odometry. benchmarks/bench_wide_search.cpp measures one call.
+// valid while the prior moves with odometry.
 //
 // Distinctiveness: periodic paint (dashed lines, zebra stripes) or a lone line along the road gives
 // peaks of nearly equal probability. The result says by how much the best beats the best candidate
-// farther than distinct_separation_m from it; the caller must refuse a small margin.
+// farther than distinct_separation_m from it, and where that one is; the caller must refuse a small
+// margin. The other peaks of periodic paint are translations of the best, so every candidate is also
+// tried at the leading one's yaw: a coarse yaw a step off must not hide an alias.
 #include <cstdint>
 #include <numbers>
 #include <vector>
@@ -49,12 +53,13 @@ struct WideApsParams {
   // Yaw step of the refinement, which covers +-half a coarse step: 0.25 deg moves S's corner 0.12 m,
   // about half a fine cell, below which the map cannot tell yaws apart.
   double fine_yaw_step_rad = 0.25 * std::numbers::pi / 180.0;
-  // Refinement window, +- this many fine cells around a coarse candidate: one coarse cell, where the
-  // fine peak can be when the coarse one is right.
+  // Refinement window, +- this many fine cells around a coarse candidate (re-centred once if the peak
+  // is on its edge): 0.6 m, more than the half coarse cell within which the fine peak lies when the
+  // coarse one is right.
   int refine_radius_cells = 3;
   // Coarse peaks refined (top k, pairwise farther apart than distinct_separation_m).
   int candidates = 4;
-  // Two peaks closer than this are one (m). Above the refinement's reach (0.8 m) and below the period
+  // Two peaks closer than this are one (m). Above the refinement's reach (0.6 m) and below the period
   // of the paint that repeats soonest on a road (a crosswalk's ~1 m is finer than the coarse level can
   // see; dashes repeat every 3-12 m), so a period of paint shows as a second candidate.
   double distinct_separation_m = 1.5;
@@ -70,19 +75,22 @@ struct WideApsParams {
 
 struct WideApsResult {
   bool ok = false;  // a finished search with enough cells at both levels
-  // The most probable pose (local frame): Eq. 15-16's centre of mass over the best candidate's
-  // refinement window, at the yaw of the centre of mass of the yaw distribution there.
+  // The most probable pose (local frame): Eq. 15-16's centre of mass over +-refine_radius_cells around
+  // the best candidate's peak at its best yaw, and the centre of mass of its yaw distribution.
   Pose2d pose;
   Pose2d correction;  // pose = correction.compose(prior): a rigid transform of the local frame
   // (x, y, yaw), local frame: x, y from Eq. 15-16's moments at the best yaw, yaw from the distribution
-  // over the refinement's yaws (each the sum of P over its offsets); each plus a step's quantisation.
+  // over the refinement's yaws (each the sum of P over +-1 cell around the peak); each plus a step's
+  // quantisation. Over a window that small a ridge (a lone line along the road) is cut short: the
+  // margin, not this, says whether the search is ambiguous.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   int cells_used = 0;  // fine cells of S in the best candidate's Eq. 14
   // Eq. 14 in logs (up to a constant) at the best pose.
   double log_p = 0;
   // Distinctiveness: log P of the best minus that of the best refined candidate farther than
-  // distinct_separation_m from it (scaled to the best's cells when they differ); +inf when there is
-  // none. Small (a few units of log P) means two places fit nearly as well.
+  // distinct_separation_m from it (per cell, times the best's cells: the candidates' cells differ a
+  // little); +inf when there is none. The noise of the difference grows with the square root of the
+  // cells: in the tests (~6500 cells, alpha 0.5) stripes every 3 m gave 6-30, unique paint thousands.
   double margin = 0;
   Pose2d runner_up;  // that candidate's pose (local frame), when margin is finite
   // The best lies within a coarse cell of the search range's border: the truth may be outside.
