@@ -308,11 +308,12 @@ OffsetBox coarse_box(const WideApsParams& p, double coarse_m) {
 
 OffsetBox square(int ci, int cj, int radius) { return {ci - radius, 2 * radius + 1, cj - radius, 2 * radius + 1}; }
 
-// The poses one fine refinement scores: offsets at the candidate's yaw, yaws around the best of those
-// at +-1 cell, and offsets at the best yaw when it differs.
+// The poses one fine refinement usually scores, to budget it: offsets at the candidate's yaw and at the
+// leading candidate's, yaws around the better peak at +-1 cell, and offsets at the best yaw (a
+// re-centring adds a box).
 int64_t refine_offsets(const WideApsParams& p) {
   const int64_t box = int64_t(2 * p.refine_radius_cells + 1) * (2 * p.refine_radius_cells + 1);
-  return 2 * box + 9 * (2 * fine_yaw_steps(p) + 1);
+  return 3 * box + 9 * (2 * fine_yaw_steps(p) + 1);
 }
 
 // The index of the largest value.
@@ -366,8 +367,14 @@ std::vector<WideApsCandidate> distinct_best(std::vector<WideApsCandidate> pool, 
 // One candidate at the map's resolution: Eq. 14 over +-R cells at its yaw (re-centred once if the
 // peak is on the box's edge), over +-K fine yaw steps at +-1 cell around that peak, and over +-R cells
 // at the best yaw; then Eq. 15-16's moments at the best yaw and the yaw distribution.
-void refine(WideApsCandidate& cand, const IntensityGrid& S, IntensityMap& map, const WideApsParams& p,
+// The work a unit did: poses scored and z-score terms summed.
+struct Work {
+  int64_t offsets = 0, terms = 0;
+};
+
+Work refine(WideApsCandidate& cand, const IntensityGrid& S, IntensityMap& map, const WideApsParams& p,
             std::optional<double> lead_yaw) {
+  Work work;
   const Pose2d& prior = S.pose;
   const Pose2d b = relative(prior, cand.correction.compose(prior));  // offset and yaw, vehicle frame
   const int R = p.refine_radius_cells, K = fine_yaw_steps(p);
@@ -378,8 +385,14 @@ void refine(WideApsCandidate& cand, const IntensityGrid& S, IntensityMap& map, c
   const Level F = fine_level(S, map, p, ci, cj, turn, 3 * R + 1);
   const double alpha = p.aps.alpha;
   // The peak of a box at yaw k of the placements: (offset i, offset j) relative to the centre.
+  // Eq. 14 in logs over a box at yaw k of the placements, counted.
+  const auto log_probabilities = [&](const Placements& pl, size_t k, const OffsetBox& box) {
+    work.offsets += box.count();
+    work.terms += int64_t(pl.cells) * box.count();
+    return aps_log_probabilities(z_score_sums(F, F.cells, pl, k, box), alpha);
+  };
   const auto peak = [&](const Placements& pl, size_t k, const OffsetBox& box, std::vector<double>& log_p) {
-    log_p = aps_log_probabilities(z_score_sums(F, F.cells, pl, k, box), alpha);
+    log_p = log_probabilities(pl, k, box);
     const size_t best = argmax(log_p);
     return std::pair<int, int>{box.i0 + int(best) % box.ni, box.j0 + int(best) / box.ni};
   };
@@ -389,44 +402,50 @@ void refine(WideApsCandidate& cand, const IntensityGrid& S, IntensityMap& map, c
     cand.log_p_per_cell = -std::numeric_limits<double>::infinity();
     return true;
   };
-  // Offsets at the candidate's yaw, re-centred once if the peak is on the box's edge. Each box is
-  // placed on its own cells: the cells-under-map rule over a larger box would drop more of S.
-  const auto offsets_at = [&](double yaw, std::vector<double>& log_p) -> std::optional<std::pair<int, int>> {
+  // Offsets at a yaw, re-centred once if the peak is on the box's edge: the peak, and its log P per
+  // cell. Each box is placed on its own cells: the cells-under-map rule over a larger box would drop
+  // more of S.
+  struct Peak {
+    int i, j;
+    double log_p_per_cell;
+  };
+  const auto offsets_at = [&](double yaw) -> std::optional<Peak> {
+    std::vector<double> log_p;
     const Placements at_yaw = place(F, {yaw}, square(0, 0, R));
     if (refused(at_yaw)) return std::nullopt;
-    std::pair<int, int> ij = peak(at_yaw, 0, square(0, 0, R), log_p);
-    if (std::abs(ij.first) < R && std::abs(ij.second) < R) return ij;
-    const Placements moved = place(F, {yaw}, square(ij.first, ij.second, R));
-    if (refused(moved)) return std::nullopt;
-    return peak(moved, 0, square(ij.first, ij.second, R), log_p);
+    auto [i, j] = peak(at_yaw, 0, square(0, 0, R), log_p);
+    int cells = at_yaw.cells;
+    if (std::abs(i) == R || std::abs(j) == R) {
+      const Placements moved = place(F, {yaw}, square(i, j, R));
+      if (refused(moved)) return std::nullopt;
+      std::tie(i, j) = peak(moved, 0, square(i, j, R), log_p);
+      cells = moved.cells;
+    }
+    return Peak{i, j, *std::max_element(log_p.begin(), log_p.end()) / cells};
   };
-  std::vector<double> log_p;
   double yaw = b.yaw;
-  std::optional<std::pair<int, int>> ij = offsets_at(yaw, log_p);
+  std::optional<Peak> found = offsets_at(yaw);
   // Periodic paint's other peaks are translations of the leading one, at its yaw; the coarse level may
   // have put them a step of yaw off, out of the refinement's reach, and the margin would then overstate
   // how distinct the best is.
   if (lead_yaw && std::fabs(*lead_yaw - b.yaw) > 0.5 * p.fine_yaw_step_rad) {
-    std::vector<double> lead_log_p;
-    const std::optional<std::pair<int, int>> at_lead = offsets_at(*lead_yaw, lead_log_p);
-    if (at_lead && (!ij || *std::max_element(lead_log_p.begin(), lead_log_p.end()) / cand.cells >
-                               *std::max_element(log_p.begin(), log_p.end()) / cand.cells))
-      ij = at_lead, yaw = *lead_yaw;
+    const std::optional<Peak> at_lead = offsets_at(*lead_yaw);
+    if (at_lead && (!found || at_lead->log_p_per_cell > found->log_p_per_cell)) found = at_lead, yaw = *lead_yaw;
   }
-  if (!ij) return;
-  const auto [i, j] = *ij;
+  if (!found) return work;
+  const int i = found->i, j = found->j;
   // The yaws and the final offsets on one set of cells, so their probabilities compare.
   std::vector<double> yaws;
   for (int k = -K; k <= K; ++k) yaws.push_back(yaw + k * p.fine_yaw_step_rad);
   const Placements pl = place(F, yaws, square(i, j, R + 1));
-  if (refused(pl)) return;
+  if (refused(pl)) return work;
   // Yaws at +-1 cell around the peak: the yaw distribution, each yaw's P summed over its offsets.
   const OffsetBox around = square(i, j, 1);
   std::vector<std::vector<double>> by_yaw(yaws.size());
   double best_log_p = -std::numeric_limits<double>::infinity();
   size_t best_yaw = size_t(K);
   for (size_t k = 0; k < yaws.size(); ++k) {
-    by_yaw[k] = aps_log_probabilities(z_score_sums(F, F.cells, pl, k, around), alpha);
+    by_yaw[k] = log_probabilities(pl, k, around);
     const double top = *std::max_element(by_yaw[k].begin(), by_yaw[k].end());
     if (top > best_log_p) best_log_p = top, best_yaw = k;
   }
@@ -443,12 +462,12 @@ void refine(WideApsCandidate& cand, const IntensityGrid& S, IntensityMap& map, c
   // Eq. 15-16 at the best yaw, around its peak.
   const size_t around_best = argmax(by_yaw[best_yaw]);
   const int bi = around.i0 + int(around_best) % around.ni, bj = around.j0 + int(around_best) / around.ni;
-  const OffsetBox final_box = square(bi, bj, R);
-  peak(pl, best_yaw, final_box, log_p);
+  const std::vector<double> log_p = log_probabilities(pl, best_yaw, square(bi, bj, R));
   const OffsetMoments m = aps_offset_moments(log_p, ApsSearchWindow{R, R, 1, F.cell_m});
   cand.offset_covariance = m.covariance;
   cand.correction = correction_at(prior, (ci + bi) * F.cell_m + m.mean.x(), (cj + bj) * F.cell_m + m.mean.y(), mean);
   cand.log_p_per_cell = *std::max_element(log_p.begin(), log_p.end()) / pl.cells;
+  return work;
 }
 
 // The best refined candidate, and the best farther than distinct_separation_m from it, at `prior`.
@@ -527,10 +546,11 @@ void WideApsSearch::step(const IntensityGrid& S, IntensityMap& map) {
                          refine_offsets(p);
     while (next_unit_ < int(refined_.size()) && afford(cost)) {
       WideApsCandidate& c = refined_[size_t(next_unit_)];
-      refine(c, S, map, p, next_unit_ > 0 ? std::optional<double>(refined_.front().correction.yaw) : std::nullopt);
+      const Work w =
+          refine(c, S, map, p, next_unit_ > 0 ? std::optional<double>(refined_.front().correction.yaw) : std::nullopt);
       ++next_unit_;
-      offsets_ += refine_offsets(p);
-      terms_ += int64_t(c.cells) * refine_offsets(p);
+      offsets_ += w.offsets;
+      terms_ += w.terms;
     }
     if (next_unit_ == int(refined_.size())) phase_ = Phase::done;
   }
