@@ -131,6 +131,34 @@ TEST(CurbHypotheses, SpreadOverStepsGivesTheOneShotAnswer) {
   EXPECT_FALSE(search.done());
 }
 
+// The car drives on between steps and the prior follows it with odometry: the corrections ICP found on
+// earlier steps still put the car where it is at the last one.
+TEST(CurbHypotheses, SpreadOverStepsFollowsAMovingPrior) {
+  const std::vector<Eigen::Vector2d> curbs = road(true);
+  const MapIndex index(curbs);
+  const Pose2d motion{0.5, 0.0, 0.5 * kDeg};  // one scan's odometry
+  Pose2d truth{-1.0, -0.8, 0.0};
+  Pose2d prior = truth.compose(Pose2d{3.0, 2.5, 2.0 * kDeg}.inverse());
+  CurbHypothesesParams p;
+  p.max_icp_runs_per_step = 40;
+  CurbHypothesisSearch search(p);
+  int steps = 0;
+  while (!search.done() && steps < 20) {
+    search.step(features_at(curbs, truth, prior, uint32_t(steps)), index, prior);
+    truth = truth.compose(motion);
+    prior = prior.compose(motion);
+    ++steps;
+  }
+  ASSERT_TRUE(search.done());
+  const CurbHypothesesResult& r = search.result();
+  ASSERT_TRUE(r.ok);
+  const Pose2d last_truth = truth.compose(motion.inverse());  // the result is at the last step's prior
+  const Pose2d e = relative(last_truth, r.best.pose);
+  EXPECT_LT(std::hypot(e.x, e.y), 0.1) << steps << " steps";
+  EXPECT_LT(std::fabs(e.yaw), 0.5 * kDeg);
+  EXPECT_FALSE(r.ambiguous_longitudinal);
+}
+
 TEST(CurbHypotheses, TooFewCurbsOrBadParametersGiveNoAnswer) {
   const MapIndex index(road(false));
   const std::vector<Eigen::Vector2d> few{{0, 5}, {1, 5}};
