@@ -128,17 +128,23 @@ const Pose2d kTruth{1.0, -0.5, 20.0 * kDeg};
 const Pose2d kError{4.0, -3.0, 3.0 * kDeg};
 const Pose2d kPrior = kTruth.compose(kError.inverse());
 
+// Each map is built on first use: CTest runs every test case in a process of its own.
 class WideSearch : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    irregular_dir_ = new std::string(build_map(irregular_paint(), "irregular"));
-    stripes_dir_ = new std::string(build_map(stripes(), "stripes"));
-  }
+  static const std::string& irregular_dir() { return dir(irregular_dir_, irregular_paint(), "irregular"); }
+  static const std::string& stripes_dir() { return dir(stripes_dir_, stripes(), "stripes"); }
   static void TearDownTestSuite() {
-    fs::remove_all(*irregular_dir_);
-    fs::remove_all(*stripes_dir_);
-    delete irregular_dir_;
-    delete stripes_dir_;
+    for (std::string** d : {&irregular_dir_, &stripes_dir_}) {
+      if (*d) fs::remove_all(**d);
+      delete *d;
+      *d = nullptr;
+    }
+  }
+
+ private:
+  static const std::string& dir(std::string*& d, const Paint& paint, const std::string& name) {
+    if (!d) d = new std::string(build_map(paint, name));
+    return *d;
   }
   static std::string* irregular_dir_;
   static std::string* stripes_dir_;
@@ -147,7 +153,7 @@ std::string* WideSearch::irregular_dir_ = nullptr;
 std::string* WideSearch::stripes_dir_ = nullptr;
 
 TEST_F(WideSearch, RecoversAKnownErrorOfMetresAndDegrees) {
-  IntensityMap map(*irregular_dir_);
+  IntensityMap map(irregular_dir());
   const IntensityGrid S = scan(irregular_paint(), kTruth, kPrior, 3);
   const auto start = std::chrono::steady_clock::now();
   const WideApsResult r = wide_aps_search(S, map);
@@ -174,7 +180,7 @@ TEST_F(WideSearch, RecoversAKnownErrorOfMetresAndDegrees) {
 }
 
 TEST_F(WideSearch, PeriodicStripesLeaveASmallMarginAlongTheRoad) {
-  IntensityMap map(*stripes_dir_);
+  IntensityMap map(stripes_dir());
   const IntensityGrid S = scan(stripes(), kTruth, kPrior, 4);
   const WideApsResult r = wide_aps_search(S, map);
   std::printf("[ wide ] stripes: pose (%.3f, %.3f), runner-up (%.3f, %.3f); margin %.2f\n", r.pose.x, r.pose.y,
@@ -190,7 +196,7 @@ TEST_F(WideSearch, PeriodicStripesLeaveASmallMarginAlongTheRoad) {
 }
 
 TEST_F(WideSearch, SpreadOverStepsGivesTheOneShotAnswer) {
-  IntensityMap map(*irregular_dir_);
+  IntensityMap map(irregular_dir());
   const IntensityGrid S = scan(irregular_paint(), kTruth, kPrior, 5);
   const WideApsResult once = wide_aps_search(S, map);
   WideApsParams p;
@@ -221,7 +227,7 @@ TEST_F(WideSearch, SpreadOverStepsGivesTheOneShotAnswer) {
 // The car drives on between steps and the prior follows it with odometry: what earlier steps found,
 // kept as corrections of the prior, still leads to the truth at the last step's prior.
 TEST_F(WideSearch, SpreadOverStepsFollowsAMovingPrior) {
-  IntensityMap map(*irregular_dir_);
+  IntensityMap map(irregular_dir());
   WideApsParams p;
   p.max_terms_per_step = 500'000;
   WideApsSearch search(p);
@@ -244,7 +250,7 @@ TEST_F(WideSearch, SpreadOverStepsFollowsAMovingPrior) {
 }
 
 TEST_F(WideSearch, RefusesBadInput) {
-  IntensityMap map(*irregular_dir_);
+  IntensityMap map(irregular_dir());
   IntensityGrid S = scan(irregular_paint(), kTruth, kPrior, 6);
   WideApsParams p;
   p.coarse_factor = 3;  // 100 cells are not whole 3-cell blocks
