@@ -470,6 +470,43 @@ Work refine(WideApsCandidate& cand, const IntensityGrid& S, IntensityMap& map, c
   return work;
 }
 
+// The verdict: every refined candidate's pose scored again on this step's S, on the cells of S with map
+// data under them at all of those poses, so that the candidates compare on one S and one set of cells
+// even when they were refined on different scans (whose S differ in content, not only in noise).
+Work verdict(std::vector<WideApsCandidate>& refined, const IntensityGrid& S, IntensityMap& map,
+             const WideApsParams& p) {
+  std::vector<WideApsCandidate*> live;
+  std::vector<Pose2d> poses;
+  for (WideApsCandidate& c : refined)
+    if (std::isfinite(c.log_p_per_cell)) live.push_back(&c), poses.push_back(c.correction.compose(S.pose));
+  std::vector<double> sums(live.size(), 0.0), terms(live.size());
+  int cells = 0;
+  for (int r = 0; r < S.params.height_cells; ++r)
+    for (int c = 0; c < S.params.width_cells; ++c) {
+      const IntensityCell& s = S.cells[size_t(r) * size_t(S.params.width_cells) + size_t(c)];
+      if (!aps_cell_usable(s, p.aps)) continue;
+      const Eigen::Vector2d v = S.cell_centre(c, r);
+      const double s_sigma = aps_cell_sigma(s, p.aps.min_sigma);
+      bool under_all = true;
+      for (size_t k = 0; k < live.size() && under_all; ++k) {
+        const std::optional<IntensityCell> m = map.cell(poses[k].apply(v));
+        under_all = m && m->count > 0;
+        if (!under_all) break;
+        const double d = m->mean - s.mean, e = aps_cell_sigma(*m, p.aps.min_sigma) + s_sigma;
+        terms[k] = d * d / (e * e);
+      }
+      if (!under_all) continue;
+      ++cells;
+      for (size_t k = 0; k < live.size(); ++k) sums[k] += terms[k];
+    }
+  for (size_t k = 0; k < live.size(); ++k) {
+    live[k]->cells = cells;
+    live[k]->log_p_per_cell =
+        cells >= p.aps.min_cells ? -0.5 * p.aps.alpha * sums[k] / cells : -std::numeric_limits<double>::infinity();
+  }
+  return {int64_t(live.size()), int64_t(live.size()) * cells};
+}
+
 // The best refined candidate, and the best farther than distinct_separation_m from it, at `prior`.
 void summarise(const std::vector<WideApsCandidate>& refined, const Pose2d& prior, const WideApsParams& p,
                double coarse_m, WideApsResult& r) {
@@ -556,7 +593,11 @@ void WideApsSearch::step(const IntensityGrid& S, IntensityMap& map) {
   }
   result_.offsets_evaluated = offsets_;
   result_.terms_evaluated = terms_;
-  if (done()) summarise(refined_, prior, p, p.coarse_factor * S.params.cell_m, result_);
+  if (!done()) return;
+  const Work w = verdict(refined_, S, map, p);
+  result_.offsets_evaluated = offsets_ += w.offsets;
+  result_.terms_evaluated = terms_ += w.terms;
+  summarise(refined_, prior, p, p.coarse_factor * S.params.cell_m, result_);
 }
 
 WideApsResult wide_aps_search(const IntensityGrid& S, IntensityMap& map, const WideApsParams& params) {

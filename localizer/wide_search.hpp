@@ -23,7 +23,9 @@
 // peaks of nearly equal probability. The result says by how much the best beats the best candidate
 // farther than distinct_separation_m from it, and where that one is; the caller must refuse a small
 // margin. The other peaks of periodic paint are translations of the best, so every candidate is also
-// tried at the leading one's yaw: a coarse yaw a step off must not hide an alias.
+// tried at the leading one's yaw: a coarse yaw a step off must not hide an alias. At the end every
+// refined candidate is scored once more on the last step's S and on the cells all of them see (the
+// verdict), so that candidates refined on different scans compare like with like.
 #include <cstdint>
 #include <numbers>
 #include <vector>
@@ -68,8 +70,8 @@ struct WideApsParams {
   int min_coarse_cells = 10;
   // Work per WideApsSearch::step, in z-score terms of Eq. 14 (one cell of S at one pose). The coarse
   // phase is ~1.5 M terms and each refinement ~2.3 M for Table I's S over a 12 m wide road, so the
-  // default runs one of them per step: 3-5 ms on one core with the map reads (bench_wide_search), five
-  // steps in all. A unit is never split: a step does at least one.
+  // default runs one of them per step: 3-6 ms on one core with the map reads (bench_wide_search), five
+  // steps in all, the last with the verdict. A unit is never split: a step does at least one.
   int64_t max_terms_per_step = 2'500'000;
 };
 
@@ -84,13 +86,16 @@ struct WideApsResult {
   // quantisation. Over a window that small a ridge (a lone line along the road) is cut short: the
   // margin, not this, says whether the search is ambiguous.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
-  int cells_used = 0;  // fine cells of S in the best candidate's Eq. 14
-  // Eq. 14 in logs (up to a constant) at the best pose.
+  // The verdict's cells: those of the last step's S with map data under them at every refined
+  // candidate's pose (the cells-under-map rule across the candidates).
+  int cells_used = 0;
+  // Eq. 14 in logs (up to a constant) at the best pose, on those cells.
   double log_p = 0;
   // Distinctiveness: log P of the best minus that of the best refined candidate farther than
-  // distinct_separation_m from it (per cell, times the best's cells: the candidates' cells differ a
-  // little); +inf when there is none. The noise of the difference grows with the square root of the
-  // cells: in the tests (~6500 cells, alpha 0.5) stripes every 3 m gave 6-30, unique paint thousands.
+  // distinct_separation_m from it, both scored on the last step's S and the same cells (the verdict);
+  // +inf when there is none. Its noise grows with the square root of the cells: in the tests (~8000
+  // cells, alpha 0.5) stripes every 3 m gave ~40, unique paint ~5000; on the campus map, S over a
+  // stretch of road with only its centre line gave below 1, with paint across the road in view 370-1200.
   double margin = 0;
   Pose2d runner_up;  // that candidate's pose (local frame), when margin is finite
   // The best lies within a coarse cell of the search range's border: the truth may be outside.

@@ -70,8 +70,8 @@ Paint stripes() {
 }
 
 // A margin of log P below which two places fit alike here: the aliases of the stripes differ by the
-// noise of ~6000 cells and by the map's resampling into the prior's turned cells (tens), unique paint
-// by thousands.
+// noise of ~8000 cells and by where the map's cells fall under S's at each (tens), unique paint by
+// thousands.
 constexpr double kAmbiguousMargin = 100.0;
 
 double intensity(const Paint& paint, const Eigen::Vector2d& p, std::mt19937& rng) {
