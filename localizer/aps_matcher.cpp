@@ -15,6 +15,8 @@
 
 #include <Eigen/Dense>
 
+#include "localizer/cell_counts.hpp"
+
 namespace lidarloop {
 namespace {
 
@@ -70,35 +72,6 @@ bool usable(const IntensityCell& s, const ApsParams& params) {
 double floored_sigma(const IntensityCell& cell, double min_sigma) {
   return std::max(std::sqrt(cell.variance()), min_sigma);
 }
-
-// The marked cells of a cols x rows grid, counted over any rectangle in O(1): a summed-area table.
-class CellCounts {
- public:
-  // marked(c, r): whether cell (c, r) counts.
-  template <class Marked>
-  CellCounts(int cols, int rows, Marked marked)
-      : cols_(cols), rows_(rows), sums_(size_t(cols + 1) * size_t(rows + 1), 0) {
-    for (int r = 0; r < rows; ++r) {
-      int in_row = 0;
-      for (int c = 0; c < cols; ++c) {
-        in_row += marked(c, r) ? 1 : 0;
-        sums_[index(c + 1, r + 1)] = sums_[index(c + 1, r)] + in_row;
-      }
-    }
-  }
-  int cols() const { return cols_; }
-  int rows() const { return rows_; }
-  // Marked cells in columns [c0, c0 + cols) and rows [r0, r0 + rows), all inside the grid.
-  int in(int c0, int r0, int cols, int rows) const {
-    return sums_[index(c0 + cols, r0 + rows)] - sums_[index(c0, r0 + rows)] - sums_[index(c0 + cols, r0)] +
-           sums_[index(c0, r0)];
-  }
-
- private:
-  size_t index(int c, int r) const { return size_t(r) * size_t(cols_ + 1) + size_t(c); }
-  int cols_, rows_;
-  std::vector<int> sums_;  // (cols + 1) x (rows + 1): the marked cells above and left of each corner
-};
 
 // Where S is usable. On a road most of S is empty (the corridor's ground only), so most of the map
 // window is never looked at and need not be read.
@@ -297,6 +270,10 @@ OffsetMoments aps_offset_moments(const std::vector<double>& log_p, const ApsSear
   covariance.diagonal().array() += window.step_m * window.step_m / 12.0;
   return {mean, covariance};
 }
+
+bool aps_cell_usable(const IntensityCell& s, const ApsParams& params) { return usable(s, params); }
+
+double aps_cell_sigma(const IntensityCell& cell, double min_sigma) { return floored_sigma(cell, min_sigma); }
 
 ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& params) {
   check_aps_inputs(S, map.header().resolution_m, params);

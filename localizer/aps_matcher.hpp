@@ -129,4 +129,10 @@ struct OffsetMoments {
 };
 OffsetMoments aps_offset_moments(const std::vector<double>& log_p, const ApsSearchWindow& window);
 
+// Eq. 14's rules for one cell, for searches that score offsets as aps_match does (wide_search.hpp):
+// whether a cell of S is in the effective area (S_n > n_e), and a cell's standard deviation with the
+// min_sigma floor.
+bool aps_cell_usable(const IntensityCell& s, const ApsParams& params);
+double aps_cell_sigma(const IntensityCell& cell, double min_sigma);
+
 }  // namespace lidarloop
