@@ -23,15 +23,16 @@ using namespace plot;
 const cv::Scalar kCurve(180, 90, 30), kTruth(120, 120, 120), kEstimate(60, 60, 60), kBackground(205, 205, 205),
     kStart(40, 160, 40), kWorst(0, 0, 200);
 // The error plot's claims (BGR): the 3-sigma band a light tint of the curve's blue, the protection
-// bounds vermillion (Okabe & Ito), lost stretches a light warm peach, fault events purple.
-const cv::Scalar kBand(245, 228, 210), kBound(0, 94, 213), kLost(200, 228, 255), kEvent(140, 40, 140);
+// bounds vermillion (Okabe & Ito), lost stretches a warm peach (at kLostOpacity), fault events purple.
+const cv::Scalar kBand(245, 228, 210), kBound(0, 94, 213), kLost(150, 200, 255), kEvent(140, 40, 140);
 
 // Error plot layout, pixels.
 constexpr int kLeftMargin = 90, kRightMargin = 30, kTopMargin = 10, kBottomMargin = 75;
 constexpr int kLegendSwatch = 12, kLegendGap = 24, kEventLabelDrop = 16;
-constexpr double kDash = 8;           // pixels
-constexpr double kSigmaBand = 3.0;    // the band's half-width in standard deviations (99.7 % when honest)
-constexpr double kMaxBandView = 3.0;  // how far a band may widen the view: value_range()
+constexpr double kDash = 8;              // pixels
+constexpr double kSigmaBand = 3.0;       // the band's half-width in standard deviations (99.7 % when honest)
+constexpr double kBandViewPercent = 90;  // of the frames whose band and bounds are in view: value_range()
+constexpr double kLostOpacity = 0.5;     // lost stretches tint what is under them
 constexpr int kPanelTitleHeight = 30, kPanelTickLabelHeight = 28;
 constexpr int kTargetTimeTicks = 10, kTargetValueTicks = 5;
 constexpr double kValuePadFraction = 0.1;  // room above and below the curve
@@ -75,18 +76,23 @@ void draw_panel(cv::Mat& image, const Panel& p, const std::vector<double>& t, co
   cv::Mat area = image(p.area);
   Panel local = p;
   local.area.x = local.area.y = 0;
-  // Lost stretches: from each lost frame to the next frame (the last one a frame period wide).
-  for (size_t i = 0; i < t.size(); ++i) {
-    if (!lost[i]) continue;
-    const double to = i + 1 < t.size() ? t[i + 1] : t[i] + (i > 0 ? t[i] - t[i - 1] : 0.0);
-    cv::rectangle(area, cv::Point(local.at(t[i], p.y1)), cv::Point(local.at(to, p.y0)), kLost, cv::FILLED);
-  }
   // The +-3 sigma band, a quadrilateral between each two frames that both have one.
   for (size_t i = 1; i < t.size(); ++i) {
     if (!std::isfinite(s.band[i - 1]) || !std::isfinite(s.band[i])) continue;
     const cv::Point corners[] = {local.at(t[i - 1], s.band[i - 1]), local.at(t[i], s.band[i]),
                                  local.at(t[i], -s.band[i]), local.at(t[i - 1], -s.band[i - 1])};
     cv::fillConvexPoly(area, corners, 4, kBand, cv::LINE_AA);
+  }
+  // Lost stretches over the band, tinting it: from each lost frame to the next frame (the last one a
+  // frame period wide).
+  for (size_t i = 0; i < t.size(); ++i) {
+    if (!lost[i]) continue;
+    const double to = i + 1 < t.size() ? t[i + 1] : t[i] + (i > 0 ? t[i] - t[i - 1] : 0.0);
+    const cv::Rect stretch =
+        cv::Rect(cv::Point(local.at(t[i], p.y1)), cv::Point(local.at(to, p.y0))) & cv::Rect(0, 0, area.cols, area.rows);
+    if (stretch.empty()) continue;
+    cv::Mat under = area(stretch);
+    cv::addWeighted(under, 1 - kLostOpacity, cv::Mat(under.size(), under.type(), kLost), kLostOpacity, 0, under);
   }
   draw_axes(image, p, title, kTargetTimeTicks, kTargetValueTicks);
   cv::line(image, p.at(p.x0, 0), p.at(p.x1, 0), kZero, 2);
@@ -102,29 +108,35 @@ void draw_panel(cv::Mat& image, const Panel& p, const std::vector<double>& t, co
   if (t.size() == 1 && std::isfinite(v[0])) cv::circle(area, local.at(t[0], v[0]), 3, kCurve, cv::FILLED, cv::LINE_AA);
 }
 
-// The half-height of a panel's view: the error's and, up to kMaxBandView times the error's, the
-// band's and bound's (a 5 m cold-start sigma must not flatten a 0.1 m error curve).
+// A panel's view: all of the error, and the band and bounds of most frames (kBandViewPercent of
+// them), so that a few seconds of 5 m cold-start sigma do not flatten a 0.1 m error curve.
 void value_range(const Series& s, double& lo, double& hi) {
   lo = hi = 0;  // the zero line is always in view
-  double claim = 0;
+  std::vector<double> claims;
   for (size_t i = 0; i < s.error.size(); ++i) {
     if (std::isfinite(s.error[i])) lo = std::min(lo, s.error[i]), hi = std::max(hi, s.error[i]);
     for (double c : {s.band[i], s.bound[i]})
-      if (std::isfinite(c)) claim = std::max(claim, c);
+      if (std::isfinite(c)) claims.push_back(c);
   }
-  claim = std::min(claim, kMaxBandView * std::max({-lo, hi, kMinHalfRange}));
+  const double claim = claims.empty() ? 0.0 : percentile_nearest_rank(claims, kBandViewPercent);
   lo = std::min(lo, -claim), hi = std::max(hi, claim);
   const double pad = std::max((hi - lo) * kValuePadFraction, kMinHalfRange);
   lo -= pad, hi += pad;
 }
 
-// One legend entry: a swatch (a filled box, or a line) and its words; returns the x after it.
-int legend_entry(cv::Mat& image, cv::Point at, const cv::Scalar& colour, bool filled, const std::string& words) {
-  if (filled)
-    cv::rectangle(image, at + cv::Point(0, -kLegendSwatch), at + cv::Point(kLegendSwatch * 2, 0), colour, cv::FILLED);
+enum class Swatch { line, dashes, box };
+
+// One legend entry: its swatch and its words; returns the x after it.
+int legend_entry(cv::Mat& image, cv::Point at, const cv::Scalar& colour, Swatch swatch, const std::string& words) {
+  const int width = kLegendSwatch * 2, mid = -kLegendSwatch / 2;
+  if (swatch == Swatch::box)
+    cv::rectangle(image, at + cv::Point(0, -kLegendSwatch), at + cv::Point(width, 0), colour, cv::FILLED);
+  else if (swatch == Swatch::line)
+    cv::line(image, at + cv::Point(0, mid), at + cv::Point(width, mid), colour, 2, cv::LINE_AA);
   else
-    cv::line(image, at + cv::Point(0, -kLegendSwatch / 2), at + cv::Point(kLegendSwatch * 2, -kLegendSwatch / 2),
-             colour, 2, cv::LINE_AA);
+    for (int x = 0; x < width; x += 2 * int(kDash))
+      cv::line(image, at + cv::Point(x, mid), at + cv::Point(std::min(x + int(kDash), width), mid), colour, 2,
+               cv::LINE_AA);
   const cv::Point words_at = at + cv::Point(kLegendSwatch * 2 + kLegendGap / 2, 0);
   text(image, words, words_at);
   int baseline = 0;
@@ -202,11 +214,11 @@ void write_error_plot(const std::string& path, const std::vector<FrameError>& er
   text(image, "time (s)", {kLeftMargin + (size.width - kLeftMargin - kRightMargin) / 2, size.height - 40},
        kTitleFontScale, Align::centre);
   cv::Point legend(kLeftMargin, size.height - 12);
-  legend.x = legend_entry(image, legend, kCurve, false, "error");
-  legend.x = legend_entry(image, legend, kBand, true, "+-3 sigma (the estimate's covariance)");
-  legend.x = legend_entry(image, legend, kBound, false, "protection bound (dashed)");
-  legend.x = legend_entry(image, legend, kLost, true, "lost");
-  legend_entry(image, legend, kEvent, false, "fault event");
+  legend.x = legend_entry(image, legend, kCurve, Swatch::line, "error");
+  legend.x = legend_entry(image, legend, kBand, Swatch::box, "+-3 sigma (the estimate's covariance)");
+  legend.x = legend_entry(image, legend, kBound, Swatch::dashes, "protection bound");
+  legend.x = legend_entry(image, legend, kLost * kLostOpacity + kWhite * (1 - kLostOpacity), Swatch::box, "lost");
+  legend_entry(image, legend, kEvent, Swatch::line, "fault event");
   save_png(path, image);
 }
 
