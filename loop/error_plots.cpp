@@ -28,7 +28,7 @@ const cv::Scalar kBand(245, 228, 210), kBound(0, 94, 213), kLost(150, 200, 255),
 
 // Error plot layout, pixels.
 constexpr int kLeftMargin = 90, kRightMargin = 30, kTopMargin = 10, kBottomMargin = 75;
-constexpr int kLegendSwatch = 12, kLegendGap = 24, kEventLabelDrop = 16;
+constexpr int kLegendSwatch = 12, kLegendGap = 24, kEventLabelDrop = 16, kEventLabelGap = 4;
 constexpr double kDash = 8;              // pixels
 constexpr double kSigmaBand = 3.0;       // the band's half-width in standard deviations (99.7 % when honest)
 constexpr double kBandViewPercent = 90;  // of the frames whose band and bounds are in view: value_range()
@@ -139,8 +139,7 @@ int legend_entry(cv::Mat& image, cv::Point at, const cv::Scalar& colour, Swatch 
                cv::LINE_AA);
   const cv::Point words_at = at + cv::Point(kLegendSwatch * 2 + kLegendGap / 2, 0);
   text(image, words, words_at);
-  int baseline = 0;
-  return words_at.x + cv::getTextSize(words, cv::FONT_HERSHEY_SIMPLEX, kTickFontScale, 1, &baseline).width + kLegendGap;
+  return words_at.x + text_width(words) + kLegendGap;
 }
 
 // A colour for 0..1 from OpenCV's Turbo map (blue = small, red = large).
@@ -203,13 +202,26 @@ void write_error_plot(const std::string& path, const std::vector<FrameError>& er
     draw_panel(image, p, t, series, lost, title);
     drawn.push_back(p);
   }
-  // Fault events across every panel, named in the top one.
-  for (const FaultEvent& event : events) {
+  // Fault events across every panel, named in the top one: right of the line, or left of it where
+  // the panel ends first, each on the first row down where it clears the labels before it.
+  std::vector<FaultEvent> in_time = events;
+  std::stable_sort(in_time.begin(), in_time.end(),
+                   [](const FaultEvent& a, const FaultEvent& b) { return a.stamp_ns < b.stamp_ns; });
+  std::vector<int> row_end;  // the right end of each row's last label, pixels
+  for (const FaultEvent& event : in_time) {
     const double at = double(event.stamp_ns) / kNsPerS;
     if (at < t0 || at > t1) continue;
     for (const Panel& p : drawn) cv::line(image, p.at(at, p.y0), p.at(at, p.y1), kEvent, 1, cv::LINE_AA);
     const Panel& top = drawn.front();
-    text(image, event.what, top.at(at, top.y1) + cv::Point(4, kEventLabelDrop), kTickFontScale, Align::left, kEvent);
+    const cv::Point line_top = top.at(at, top.y1);
+    const int width = text_width(event.what);
+    const bool fits_right = line_top.x + kEventLabelGap + width <= top.area.x + top.area.width;
+    const int left = fits_right ? line_top.x + kEventLabelGap : line_top.x - kEventLabelGap - width;
+    size_t row = 0;
+    while (row < row_end.size() && left <= row_end[row] + kEventLabelGap) ++row;
+    if (row == row_end.size()) row_end.push_back(0);
+    row_end[row] = left + width;
+    text(image, event.what, {left, line_top.y + kEventLabelDrop * int(row + 1)}, kTickFontScale, Align::left, kEvent);
   }
   text(image, "time (s)", {kLeftMargin + (size.width - kLeftMargin - kRightMargin) / 2, size.height - 40},
        kTitleFontScale, Align::centre);
