@@ -53,13 +53,20 @@ struct Series {
   std::vector<double> error, band, bound;
 };
 
+// `v` clamped to a panel's height beyond either edge of its view: the clipped drawing looks the same,
+// and a bound of 1e12 m neither overflows a pixel coordinate nor takes 1e14 dashes to draw.
+double in_reach(const Panel& p, double v) {
+  const double span = p.y1 - p.y0;
+  return std::clamp(v, p.y0 - span, p.y1 + span);
+}
+
 // A polyline drawn in dashes of kDash pixels, broken where a value is not finite.
 void dashed(cv::Mat& image, const Panel& p, const std::vector<double>& t, const std::vector<double>& v,
             const cv::Scalar& colour) {
   double along = 0;  // pixels drawn since the line's start: the dash pattern runs on across frames
   for (size_t i = 1; i < t.size(); ++i) {
     if (!std::isfinite(v[i - 1]) || !std::isfinite(v[i])) continue;
-    const cv::Point2d a = p.at(t[i - 1], v[i - 1]), b = p.at(t[i], v[i]);
+    const cv::Point2d a = p.at(t[i - 1], in_reach(p, v[i - 1])), b = p.at(t[i], in_reach(p, v[i]));
     const double length = cv::norm(b - a);
     for (double d = 0; d < length; d += kDash) {
       const double to = std::min(d + kDash, length);
@@ -79,8 +86,9 @@ void draw_panel(cv::Mat& image, const Panel& p, const std::vector<double>& t, co
   // The +-3 sigma band, a quadrilateral between each two frames that both have one.
   for (size_t i = 1; i < t.size(); ++i) {
     if (!std::isfinite(s.band[i - 1]) || !std::isfinite(s.band[i])) continue;
-    const cv::Point corners[] = {local.at(t[i - 1], s.band[i - 1]), local.at(t[i], s.band[i]),
-                                 local.at(t[i], -s.band[i]), local.at(t[i - 1], -s.band[i - 1])};
+    const double before = in_reach(p, s.band[i - 1]), after = in_reach(p, s.band[i]);
+    const cv::Point corners[] = {local.at(t[i - 1], before), local.at(t[i], after), local.at(t[i], -after),
+                                 local.at(t[i - 1], -before)};
     cv::fillConvexPoly(area, corners, 4, kBand, cv::LINE_AA);
   }
   // Lost stretches over the band, tinting it: from each lost frame to the next frame (the last one a

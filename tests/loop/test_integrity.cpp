@@ -431,6 +431,11 @@ TEST(IntegrityFiles, ErrorPlotShadesLostStretchesAndTheSigmaBand) {
   const std::string calm_png = temp_path("errors_calm.png");
   write_error_plot(calm_png, score(straight_truth(20), calm, straight_route(), {}, "m", "s").errors, events);
   EXPECT_GT(count_warm(image), count_warm(cv::imread(calm_png)) + 5000);
+  // An absurd claim (a bound and a sigma of 1e12 m) is drawn clipped at the panel, not dash by dash.
+  auto absurd = run.errors;
+  absurd[50].protection_lateral_m = absurd[50].sigma_lateral_m = 1e12;
+  write_error_plot(calm_png, absurd, events);
+  EXPECT_EQ(cv::imread(calm_png).cols, 1200);
 }
 
 }  // namespace
