@@ -18,11 +18,12 @@
 // from that frame to the map's:
 //   P_vehicle = R^T P_xy R,  R = [c -s; s c],  c = cos(psi_gt), s = sin(psi_gt), whose diagonal is
 //   s_long^2 = c^2 Pxx + 2 c s Pxy + s^2 Pyy,  s_lat^2 = s^2 Pxx - 2 c s Pxy + c^2 Pyy,  s_yaw^2 = P(2,2)
-// and each axis' normalised estimation error squared is NEES = e^2 / s^2 (e_lat / s_lat, ...). For a
+// and each axis' normalised estimation error squared is NEES = e^2 / s^2 (e_lat^2 / s_lat^2, ...). For a
 // filter whose covariance is honest, each NEES is chi-square with one degree of freedom: mean 1, and
 // |e| > 3 s in 0.27 % of frames. Metrics average it per axis over the scored frames that are not
-// `lost` and whose variance on that axis is positive (NaN when there are none: a TUM estimate has no
-// covariance). A mean of 4 says the covariance claims twice the accuracy the estimate has.
+// `lost` and whose variance on that axis is positive, beyond the rotation's round-off (NaN when there
+// are none: a TUM estimate has no covariance). A mean of 4 says the covariance claims twice the
+// accuracy the estimate has.
 //
 // Integrity: a frame is misleading when its estimate is not `lost` and its error exceeds a protection
 // bound it gave, |e_lat| > protection_lateral_m or |e_long| > protection_longitudinal_m (a frame
