@@ -22,9 +22,17 @@ using namespace plot;
 // Look: the plot canvas's ink, and the curves' own colours.
 const cv::Scalar kCurve(180, 90, 30), kTruth(120, 120, 120), kEstimate(60, 60, 60), kBackground(205, 205, 205),
     kStart(40, 160, 40), kWorst(0, 0, 200);
+// The error plot's claims (BGR): the 3-sigma band a light tint of the curve's blue, the protection
+// bounds vermillion (Okabe & Ito), lost stretches a warm peach (at kLostOpacity), fault events purple.
+const cv::Scalar kBand(245, 228, 210), kBound(0, 94, 213), kLost(150, 200, 255), kEvent(140, 40, 140);
 
 // Error plot layout, pixels.
-constexpr int kLeftMargin = 90, kRightMargin = 30, kTopMargin = 10, kBottomMargin = 50;
+constexpr int kLeftMargin = 90, kRightMargin = 30, kTopMargin = 10, kBottomMargin = 75;
+constexpr int kLegendSwatch = 12, kLegendGap = 24, kEventLabelDrop = 16, kEventLabelGap = 4;
+constexpr double kDash = 8;              // pixels
+constexpr double kSigmaBand = 3.0;       // the band's half-width in standard deviations (99.7 % when honest)
+constexpr double kBandViewPercent = 90;  // of the frames whose band and bounds are in view: value_range()
+constexpr double kLostOpacity = 0.5;     // lost stretches tint what is under them
 constexpr int kPanelTitleHeight = 30, kPanelTickLabelHeight = 28;
 constexpr int kTargetTimeTicks = 10, kTargetValueTicks = 5;
 constexpr double kValuePadFraction = 0.1;  // room above and below the curve
@@ -39,15 +47,107 @@ constexpr int kErrorLineThickness = 5, kMarkerRadius = 8;
 constexpr double kMinColourScale_m = 0.01;
 constexpr int kColourBarTicks = 5;
 
-void draw_panel(cv::Mat& image, const Panel& p, const std::vector<double>& t, const std::vector<double>& v,
-                const std::string& title) {
+// One panel's data: the error, its 3-sigma half-width and (lateral, longitudinal) protection bound
+// per frame, NaN where not given.
+struct Series {
+  std::vector<double> error, band, bound;
+};
+
+// `v` clamped to a panel's height beyond either edge of its view: the clipped drawing looks the same,
+// and a bound of 1e12 m neither overflows a pixel coordinate nor takes 1e14 dashes to draw.
+double in_reach(const Panel& p, double v) {
+  const double span = p.y1 - p.y0;
+  return std::clamp(v, p.y0 - span, p.y1 + span);
+}
+
+// A polyline drawn in dashes of kDash pixels, broken where a value is not finite.
+void dashed(cv::Mat& image, const Panel& p, const std::vector<double>& t, const std::vector<double>& v,
+            const cv::Scalar& colour) {
+  double along = 0;  // pixels drawn since the line's start: the dash pattern runs on across frames
+  for (size_t i = 1; i < t.size(); ++i) {
+    if (!std::isfinite(v[i - 1]) || !std::isfinite(v[i])) continue;
+    const cv::Point2d a = p.at(t[i - 1], in_reach(p, v[i - 1])), b = p.at(t[i], in_reach(p, v[i]));
+    const double length = cv::norm(b - a);
+    for (double d = 0; d < length; d += kDash) {
+      const double to = std::min(d + kDash, length);
+      if (int(std::floor((along + d) / kDash)) % 2 == 0)
+        cv::line(image, a + (b - a) * (d / length), a + (b - a) * (to / length), colour, 2, cv::LINE_AA);
+    }
+    along += length;
+  }
+}
+
+void draw_panel(cv::Mat& image, const Panel& p, const std::vector<double>& t, const Series& s,
+                const std::vector<bool>& lost, const std::string& title) {
+  // Drawn into the panel's own pixels, so a band or bound beyond the view is clipped at its frame.
+  cv::Mat area = image(p.area);
+  Panel local = p;
+  local.area.x = local.area.y = 0;
+  // The +-3 sigma band, a quadrilateral between each two frames that both have one.
+  for (size_t i = 1; i < t.size(); ++i) {
+    if (!std::isfinite(s.band[i - 1]) || !std::isfinite(s.band[i])) continue;
+    const double before = in_reach(p, s.band[i - 1]), after = in_reach(p, s.band[i]);
+    const cv::Point corners[] = {local.at(t[i - 1], before), local.at(t[i], after), local.at(t[i], -after),
+                                 local.at(t[i - 1], -before)};
+    cv::fillConvexPoly(area, corners, 4, kBand, cv::LINE_AA);
+  }
+  // Lost stretches over the band, tinting it: from each lost frame to the next frame (the last one a
+  // frame period wide).
+  for (size_t i = 0; i < t.size(); ++i) {
+    if (!lost[i]) continue;
+    const double to = i + 1 < t.size() ? t[i + 1] : t[i] + (i > 0 ? t[i] - t[i - 1] : 0.0);
+    const cv::Rect stretch =
+        cv::Rect(cv::Point(local.at(t[i], p.y1)), cv::Point(local.at(to, p.y0))) & cv::Rect(0, 0, area.cols, area.rows);
+    if (stretch.empty()) continue;
+    cv::Mat under = area(stretch);
+    cv::addWeighted(under, 1 - kLostOpacity, cv::Mat(under.size(), under.type(), kLost), kLostOpacity, 0, under);
+  }
   draw_axes(image, p, title, kTargetTimeTicks, kTargetValueTicks);
   cv::line(image, p.at(p.x0, 0), p.at(p.x1, 0), kZero, 2);
+  std::vector<double> below(s.bound.size());
+  std::transform(s.bound.begin(), s.bound.end(), below.begin(), [](double b) { return -b; });
+  dashed(area, local, t, s.bound, kBound);
+  dashed(area, local, t, below, kBound);
   // The curve, broken where a value is not finite (a diverged estimate) rather than drawn through it.
+  const std::vector<double>& v = s.error;
   for (size_t i = 1; i < t.size(); ++i)
     if (std::isfinite(v[i - 1]) && std::isfinite(v[i]))
-      cv::line(image, p.at(t[i - 1], v[i - 1]), p.at(t[i], v[i]), kCurve, 2, cv::LINE_AA);
-  if (t.size() == 1 && std::isfinite(v[0])) cv::circle(image, p.at(t[0], v[0]), 3, kCurve, cv::FILLED, cv::LINE_AA);
+      cv::line(area, local.at(t[i - 1], v[i - 1]), local.at(t[i], v[i]), kCurve, 2, cv::LINE_AA);
+  if (t.size() == 1 && std::isfinite(v[0])) cv::circle(area, local.at(t[0], v[0]), 3, kCurve, cv::FILLED, cv::LINE_AA);
+}
+
+// A panel's view: all of the error, and the band and bounds of most frames (kBandViewPercent of
+// them), so that a few seconds of 5 m cold-start sigma do not flatten a 0.1 m error curve.
+void value_range(const Series& s, double& lo, double& hi) {
+  lo = hi = 0;  // the zero line is always in view
+  std::vector<double> claims;
+  for (size_t i = 0; i < s.error.size(); ++i) {
+    if (std::isfinite(s.error[i])) lo = std::min(lo, s.error[i]), hi = std::max(hi, s.error[i]);
+    for (double c : {s.band[i], s.bound[i]})
+      if (std::isfinite(c)) claims.push_back(c);
+  }
+  const double claim = claims.empty() ? 0.0 : percentile_nearest_rank(claims, kBandViewPercent);
+  lo = std::min(lo, -claim), hi = std::max(hi, claim);
+  const double pad = std::max((hi - lo) * kValuePadFraction, kMinHalfRange);
+  lo -= pad, hi += pad;
+}
+
+enum class Swatch { line, dashes, box };
+
+// One legend entry: its swatch and its words; returns the x after it.
+int legend_entry(cv::Mat& image, cv::Point at, const cv::Scalar& colour, Swatch swatch, const std::string& words) {
+  const int width = kLegendSwatch * 2, mid = -kLegendSwatch / 2;
+  if (swatch == Swatch::box)
+    cv::rectangle(image, at + cv::Point(0, -kLegendSwatch), at + cv::Point(width, 0), colour, cv::FILLED);
+  else if (swatch == Swatch::line)
+    cv::line(image, at + cv::Point(0, mid), at + cv::Point(width, mid), colour, 2, cv::LINE_AA);
+  else
+    for (int x = 0; x < width; x += 2 * int(kDash))
+      cv::line(image, at + cv::Point(x, mid), at + cv::Point(std::min(x + int(kDash), width), mid), colour, 2,
+               cv::LINE_AA);
+  const cv::Point words_at = at + cv::Point(kLegendSwatch * 2 + kLegendGap / 2, 0);
+  text(image, words, words_at);
+  return words_at.x + text_width(words) + kLegendGap;
 }
 
 // A colour for 0..1 from OpenCV's Turbo map (blue = small, red = large).
@@ -65,43 +165,80 @@ cv::Scalar turbo(double fraction) {
 
 }  // namespace
 
-void write_error_plot(const std::string& path, const std::vector<FrameError>& errors, const PlotSize& size) {
+void write_error_plot(const std::string& path, const std::vector<FrameError>& errors,
+                      const std::vector<FaultEvent>& events, const PlotSize& size) {
   check_size(path, size.width, size.height);
   cv::Mat image(size.height, size.width, CV_8UC3, kWhite);
-  std::vector<double> t, lateral, longitudinal, heading;
+  std::vector<double> t;
+  std::vector<bool> lost;
+  Series lateral, longitudinal, heading;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   for (const auto& e : errors) {
     t.push_back(double(e.stamp_ns) / kNsPerS);
-    lateral.push_back(e.lateral_m);
-    longitudinal.push_back(e.longitudinal_m);
-    heading.push_back(e.heading_rad * kDegPerRad);
+    lost.push_back(e.lost);
+    lateral.error.push_back(e.lateral_m);
+    lateral.band.push_back(kSigmaBand * e.sigma_lateral_m);
+    lateral.bound.push_back(e.protection_lateral_m);
+    longitudinal.error.push_back(e.longitudinal_m);
+    longitudinal.band.push_back(kSigmaBand * e.sigma_longitudinal_m);
+    longitudinal.bound.push_back(e.protection_longitudinal_m);
+    heading.error.push_back(e.heading_rad * kDegPerRad);
+    heading.band.push_back(kSigmaBand * e.sigma_heading_rad * kDegPerRad);
+    heading.bound.push_back(kNaN);  // no heading protection bound
   }
   double t0 = t.empty() ? 0 : t.front(), t1 = t.empty() ? kMinTimeSpan_s : t.back();
   if (t1 - t0 < kMinTimeSpan_s) t1 = t0 + kMinTimeSpan_s;
 
   const int panel_step = (size.height - kTopMargin - kBottomMargin) / 3;
   const struct {
-    const std::vector<double>* values;
+    const Series* series;
     const char* name;
     const char* unit;
   } panels[] = {
       {&lateral, "lateral error", "m"}, {&longitudinal, "longitudinal error", "m"}, {&heading, "heading error", "deg"}};
+  std::vector<Panel> drawn;
   for (int k = 0; k < 3; ++k) {
-    const auto& v = *panels[k].values;
-    double lo = 0, hi = 0;  // the zero line is always in view
-    for (double x : v)
-      if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
-    const double pad = std::max((hi - lo) * kValuePadFraction, kMinHalfRange);
+    const Series& series = *panels[k].series;
     Panel p;
     p.area = cv::Rect(kLeftMargin, kTopMargin + k * panel_step + kPanelTitleHeight,
                       size.width - kLeftMargin - kRightMargin, panel_step - kPanelTitleHeight - kPanelTickLabelHeight);
-    p.x0 = t0, p.x1 = t1, p.y0 = lo - pad, p.y1 = hi + pad;
-    const std::string title =
-        std::string(panels[k].name) + " (" + panels[k].unit + ")" +
-        (v.empty() ? std::string(": no scored frames") : ", RMSE " + fixed(rmse(v), 3) + " " + panels[k].unit);
-    draw_panel(image, p, t, v, title);
+    p.x0 = t0, p.x1 = t1;
+    value_range(series, p.y0, p.y1);
+    const std::string title = std::string(panels[k].name) + " (" + panels[k].unit + ")" +
+                              (series.error.empty() ? std::string(": no scored frames")
+                                                    : ", RMSE " + fixed(rmse(series.error), 3) + " " + panels[k].unit);
+    draw_panel(image, p, t, series, lost, title);
+    drawn.push_back(p);
   }
-  text(image, "time (s)", {kLeftMargin + (size.width - kLeftMargin - kRightMargin) / 2, size.height - 12},
+  // Fault events across every panel, named in the top one: right of the line, or left of it where
+  // the panel ends first, each on the first row down where it clears the labels before it.
+  std::vector<FaultEvent> in_time = events;
+  std::stable_sort(in_time.begin(), in_time.end(),
+                   [](const FaultEvent& a, const FaultEvent& b) { return a.stamp_ns < b.stamp_ns; });
+  std::vector<int> row_end;  // the right end of each row's last label, pixels
+  for (const FaultEvent& event : in_time) {
+    const double at = double(event.stamp_ns) / kNsPerS;
+    if (at < t0 || at > t1) continue;
+    for (const Panel& p : drawn) cv::line(image, p.at(at, p.y0), p.at(at, p.y1), kEvent, 1, cv::LINE_AA);
+    const Panel& top = drawn.front();
+    const cv::Point line_top = top.at(at, top.y1);
+    const int width = text_width(event.what);
+    const bool fits_right = line_top.x + kEventLabelGap + width <= top.area.x + top.area.width;
+    const int left = fits_right ? line_top.x + kEventLabelGap : line_top.x - kEventLabelGap - width;
+    size_t row = 0;
+    while (row < row_end.size() && left <= row_end[row] + kEventLabelGap) ++row;
+    if (row == row_end.size()) row_end.push_back(0);
+    row_end[row] = left + width;
+    text(image, event.what, {left, line_top.y + kEventLabelDrop * int(row + 1)}, kTickFontScale, Align::left, kEvent);
+  }
+  text(image, "time (s)", {kLeftMargin + (size.width - kLeftMargin - kRightMargin) / 2, size.height - 40},
        kTitleFontScale, Align::centre);
+  cv::Point legend(kLeftMargin, size.height - 12);
+  legend.x = legend_entry(image, legend, kCurve, Swatch::line, "error");
+  legend.x = legend_entry(image, legend, kBand, Swatch::box, "+-3 sigma (the estimate's covariance)");
+  legend.x = legend_entry(image, legend, kBound, Swatch::dashes, "protection bound");
+  legend.x = legend_entry(image, legend, kLost * kLostOpacity + kWhite * (1 - kLostOpacity), Swatch::box, "lost");
+  legend_entry(image, legend, kEvent, Swatch::line, "fault event");
   save_png(path, image);
 }
 

@@ -14,8 +14,12 @@ struct PlotSize {
 };
 
 // Three stacked panels sharing the time axis: lateral (m), longitudinal (m) and heading (deg) error,
-// each with its RMSE in the title, tick labels, grid and a zero line.
-void write_error_plot(const std::string& path, const std::vector<FrameError>& errors, const PlotSize& size = {});
+// each with its RMSE in the title (over every frame drawn), tick labels, grid and a zero line; around
+// zero the +-3 sigma band the estimate claims on that axis (in the truth's frame, loop/scorer.hpp),
+// on the lateral and longitudinal panels the protection bounds (dashed); `lost` stretches shaded
+// across every panel, each of `events` a vertical line named at the top, and a legend.
+void write_error_plot(const std::string& path, const std::vector<FrameError>& errors,
+                      const std::vector<FaultEvent>& events = {}, const PlotSize& size = {});
 
 // North up, equal aspect, framed on the trajectories: the truth trajectory drawn thin, over it the
 // stretch the estimates cover coloured by position error with a colour bar, the estimate as a thin

@@ -24,6 +24,11 @@ void text(cv::Mat& image, const std::string& s, cv::Point at, double scale, Alig
   cv::putText(image, s, at, kFont, scale, colour, 1, cv::LINE_AA);
 }
 
+int text_width(const std::string& s, double scale) {
+  int baseline = 0;
+  return cv::getTextSize(s, kFont, scale, 1, &baseline).width;
+}
+
 double nice_floor(double value) {
   const double decade = std::pow(10.0, std::floor(std::log10(value)));
   for (double m : {5.0, 2.0, 1.0})

@@ -17,6 +17,8 @@ enum class Align { left, centre, right };
 // Text with its baseline at `at`, aligned horizontally about at.x.
 void text(cv::Mat& image, const std::string& s, cv::Point at, double scale = kTickFontScale, Align align = Align::left,
           const cv::Scalar& colour = kInk);
+// The width of `s` in pixels as text() draws it.
+int text_width(const std::string& s, double scale = kTickFontScale);
 
 double nice_floor(double value);            // 1, 2 or 5 times a power of ten, the largest <= value
 double tick_step(double span, int target);  // a 1-2-5 step giving about `target` ticks

@@ -73,10 +73,25 @@ std::string joined(const std::vector<std::string>& parts, const std::string& sep
 std::string cell(double value, const char* pattern) { return std::isfinite(value) ? format(pattern, value) : "n/a"; }
 
 std::string summary(const Metrics& m) {
-  return std::to_string(m.frames) + " frames; lateral RMSE " + format("%.3f", m.lateral_rmse_m) +
-         " m, longitudinal RMSE " + format("%.3f", m.longitudinal_rmse_m) + " m, heading RMSE " +
-         format("%.3f", m.heading_rmse_deg) + " deg, max position error " + format("%.3f", m.max_position_error_m) +
-         " m, latency p50 " + cell(m.latency_p50_ms, "%.2f ms") + ", coverage " + cell(100 * m.coverage, "%.1f%%");
+  std::string text = std::to_string(m.frames) + " frames; lateral RMSE " + format("%.3f", m.lateral_rmse_m) +
+                     " m, longitudinal RMSE " + format("%.3f", m.longitudinal_rmse_m) + " m, heading RMSE " +
+                     format("%.3f", m.heading_rmse_deg) + " deg, max position error " +
+                     format("%.3f", m.max_position_error_m) + " m, latency p50 " + cell(m.latency_p50_ms, "%.2f ms") +
+                     ", coverage " + cell(100 * m.coverage, "%.1f%%");
+  text += "; " + consistency_text(m) + "; " + integrity_text(m);
+  for (const EventRecovery& r : m.recovery) text += "; " + recovery_text(r);
+  return text;
+}
+
+json recovery_json(const std::vector<EventRecovery>& events) {
+  json out = json::array();
+  for (const EventRecovery& r : events)
+    out.push_back({{"event", r.event.what},
+                   {"t_s", double(r.event.stamp_ns) / double(kNsPerS)},
+                   {"converged_after_s", finite_or_null(r.converged_after_s)},
+                   {"lost_raised_after_s", finite_or_null(r.lost_raised_after_s)},
+                   {"lost_cleared_after_s", finite_or_null(r.lost_cleared_after_s)}});
+  return out;
 }
 
 std::string markdown_cell(std::string s) {
@@ -141,6 +156,22 @@ std::string metrics_json(const Metrics& m) {
       {"max_lane_offset_m", finite_or_null(m.max_lane_offset_m)},
       {"curb_hidden_fraction", finite_or_null(m.curb_hidden_fraction)},
       {"curb_hidden_fraction_max", finite_or_null(m.curb_hidden_fraction_max)},
+      {"recovery_frames", m.recovery_frames},
+      {"consistency",
+       {{"frames_with_covariance", m.consistency.frames},
+        {"mean_nees_lateral", finite_or_null(m.consistency.mean_nees_lateral)},
+        {"mean_nees_longitudinal", finite_or_null(m.consistency.mean_nees_longitudinal)},
+        {"mean_nees_heading", finite_or_null(m.consistency.mean_nees_heading)},
+        {"beyond_3_sigma_lateral", finite_or_null(m.consistency.beyond_3_sigma_lateral)},
+        {"beyond_3_sigma_longitudinal", finite_or_null(m.consistency.beyond_3_sigma_longitudinal)},
+        {"beyond_3_sigma_heading", finite_or_null(m.consistency.beyond_3_sigma_heading)},
+        {"beyond_3_sigma_any", finite_or_null(m.consistency.beyond_3_sigma_any)}}},
+      {"integrity",
+       {{"frames_with_bounds", m.integrity.frames_with_bounds},
+        {"misleading_frames", m.integrity.misleading_frames},
+        {"misleading_fraction", finite_or_null(m.integrity.misleading_fraction)},
+        {"availability", finite_or_null(m.integrity.availability)}}},
+      {"recovery", recovery_json(m.recovery)},
       {"thresholds",
        {{"lateral_rmse_m", optional_or_null(m.thresholds.lateral_rmse_m)},
         {"longitudinal_rmse_m", optional_or_null(m.thresholds.longitudinal_rmse_m)},
@@ -148,7 +179,17 @@ std::string metrics_json(const Metrics& m) {
         {"max_position_error_m", optional_or_null(m.thresholds.max_position_error_m)},
         {"max_lane_offset_m", optional_or_null(m.thresholds.max_lane_offset_m)},
         {"settle_s", m.thresholds.settle_s},
-        {"min_coverage", optional_or_null(m.thresholds.min_coverage)}}},
+        {"min_coverage", optional_or_null(m.thresholds.min_coverage)},
+        {"max_misleading_fraction", optional_or_null(m.thresholds.max_misleading_fraction)},
+        {"min_availability", optional_or_null(m.thresholds.min_availability)},
+        {"alert_limit_lateral_m", m.thresholds.alert_limit_lateral_m},
+        {"alert_limit_longitudinal_m", m.thresholds.alert_limit_longitudinal_m},
+        {"min_mean_nees", optional_or_null(m.thresholds.min_mean_nees)},
+        {"max_mean_nees", optional_or_null(m.thresholds.max_mean_nees)},
+        {"recovery", m.thresholds.recovery ? json{{"position_m", m.thresholds.recovery->position_m},
+                                                  {"within_s", m.thresholds.recovery->within_s},
+                                                  {"lost_within_s", m.thresholds.recovery->lost_within_s}}
+                                           : json(nullptr)}}},
       {"pass", m.pass},
       {"failures", m.failures},
   };
@@ -161,6 +202,41 @@ std::string curb_occlusion_text(const Metrics& m) {
          "% of the curb samples in range (worst scan " + format("%.1f", 100 * m.curb_hidden_fraction_max) + "%)";
 }
 
+std::string consistency_text(const Metrics& m) {
+  const Consistency& c = m.consistency;
+  if (!std::isfinite(c.mean_nees_lateral) && !std::isfinite(c.mean_nees_longitudinal) &&
+      !std::isfinite(c.mean_nees_heading))
+    return "no covariance to check (no frame not lost with a positive variance)";
+  return "mean NEES lateral " + cell(c.mean_nees_lateral, "%.2f") + ", longitudinal " +
+         cell(c.mean_nees_longitudinal, "%.2f") + ", heading " + cell(c.mean_nees_heading, "%.2f") +
+         " (1 when honest); beyond 3 sigma " + cell(100 * c.beyond_3_sigma_any, "%.2f%%") + " of " +
+         std::to_string(c.frames) + " frames";
+}
+
+std::string integrity_text(const Metrics& m) {
+  const Integrity& in = m.integrity;
+  const std::string limits = "alert limits " + format("%.2f", m.thresholds.alert_limit_lateral_m) + " m lateral, " +
+                             format("%.2f", m.thresholds.alert_limit_longitudinal_m) + " m longitudinal";
+  if (in.frames_with_bounds == 0)
+    return "no protection bounds given; available " + cell(100 * in.availability, "%.1f%%") + " (" + limits + ")";
+  return "misleading " + std::to_string(in.misleading_frames) + " of " + std::to_string(in.frames_with_bounds) +
+         " frames with bounds (" + cell(100 * in.misleading_fraction, "%.2f%%") + "), available " +
+         cell(100 * in.availability, "%.1f%%") + " (" + limits + ")";
+}
+
+std::string recovery_text(const EventRecovery& r) {
+  return r.event.what + " at " + format("%.2f s", double(r.event.stamp_ns) / double(kNsPerS)) + ": converged after " +
+         cell(r.converged_after_s, "%.2f s") + ", lost raised after " + cell(r.lost_raised_after_s, "%.2f s") +
+         ", cleared after " + cell(r.lost_cleared_after_s, "%.2f s");
+}
+
+std::string integrity_lines(const Metrics& m, const std::string& label) {
+  const std::string who = label.empty() ? "" : label + ": ";
+  std::string text = "nees       " + who + consistency_text(m) + "\nintegrity  " + who + integrity_text(m) + "\n";
+  for (const EventRecovery& r : m.recovery) text += "recovery   " + who + recovery_text(r) + "\n";
+  return text;
+}
+
 void write_metrics_json(const std::string& path, const Metrics& metrics) {
   write_text_file(path, metrics_json(metrics));
 }
@@ -168,7 +244,8 @@ void write_metrics_json(const std::string& path, const Metrics& metrics) {
 void write_errors_csv(const std::string& path, const ScoredRun& run, const std::vector<EstimateRecord>& estimates) {
   std::string text =
       "t_s,lateral_m,longitudinal_m,heading_deg,position_m,est_x_m,est_y_m,est_yaw_rad,truth_x_m,truth_y_m,"
-      "truth_yaw_rad,status,latency_ms,sigma_x_m,sigma_y_m,sigma_yaw_deg\n";
+      "truth_yaw_rad,status,latency_ms,sigma_x_m,sigma_y_m,sigma_yaw_deg,sigma_lateral_m,sigma_longitudinal_m,"
+      "nees_lateral,nees_longitudinal,nees_heading,protection_lateral_m,protection_longitudinal_m,lost,misleading\n";
   for (size_t i = 0; i < run.errors.size(); ++i) {
     const FrameError& e = run.errors[i];
     const EstimateRecord& est = estimates.at(run.estimate_index.at(i));
@@ -178,7 +255,12 @@ void write_errors_csv(const std::string& path, const ScoredRun& run, const std::
             number(e.heading_rad * kDegPerRad) + ',' + number(e.position_m) + ',' + number(e.estimate.x) + ',' +
             number(e.estimate.y) + ',' + number(e.estimate.yaw) + ',' + number(e.truth.x) + ',' + number(e.truth.y) +
             ',' + number(e.truth.yaw) + ',' + csv_field(est.status) + ',' + number(est.latency_ms) + ',' +
-            number(sigma(0)) + ',' + number(sigma(1)) + ',' + number(sigma(2) * kDegPerRad) + '\n';
+            number(sigma(0)) + ',' + number(sigma(1)) + ',' + number(sigma(2) * kDegPerRad) + ',' +
+            number(e.sigma_lateral_m) + ',' + number(e.sigma_longitudinal_m) + ',' +
+            number(nees(e.lateral_m, e.sigma_lateral_m)) + ',' +
+            number(nees(e.longitudinal_m, e.sigma_longitudinal_m)) + ',' +
+            number(nees(e.heading_rad, e.sigma_heading_rad)) + ',' + number(e.protection_lateral_m) + ',' +
+            number(e.protection_longitudinal_m) + ',' + (e.lost ? '1' : '0') + ',' + (misleading(e) ? '1' : '0') + '\n';
   }
   write_text_file(path, text);
 }

@@ -24,7 +24,10 @@ std::string metrics_json(const Metrics& metrics);
 void write_metrics_json(const std::string& path, const Metrics& metrics);
 
 // errors.csv: one line per scored estimate: time, the errors (heading in degrees: this file is read
-// by people and plotting scripts), both poses, the estimate's status, latency and standard deviations.
+// by people and plotting scripts), both poses, the estimate's status, latency and standard deviations
+// (map axes), then (loop/scorer.hpp's conventions) the lateral and longitudinal standard deviations in
+// the truth's frame, the NEES per axis (nan without a variance), the protection bounds (nan when not
+// given), lost and misleading (0 or 1).
 void write_errors_csv(const std::string& path, const ScoredRun& run, const std::vector<EstimateRecord>& estimates);
 
 // TUM trajectory for evo: `t x y z qx qy qz qw`, t in seconds, z = 0, the yaw as a rotation about z
@@ -48,5 +51,15 @@ void write_comparison_csv(const std::string& path, const std::vector<Metrics>& r
 // For people: how much of the curb the traffic hid over the run and in its worst scan, e.g.
 // "the traffic hid 12.3% of the curb samples in range (worst scan 45.6%)".
 std::string curb_occlusion_text(const Metrics& m);
+// For people: the covariance's consistency, e.g. "mean NEES lateral 1.02, longitudinal 2.80, heading
+// 0.90 (1 when honest); beyond 3 sigma 1.20% of 540 frames"; n/a where an axis has no variance.
+std::string consistency_text(const Metrics& m);
+// For people: "misleading 0 of 540 frames with bounds (0.00%), available 93.1% (alert limits ...)".
+std::string integrity_text(const Metrics& m);
+// For people: "kidnap at 10.00 s: converged after 1.50 s, lost raised after 0.40 s, cleared after 2.00 s".
+std::string recovery_text(const EventRecovery& r);
+// The three above as a command's summary lines ("nees       ...", "integrity  ...", one "recovery   ..."
+// per event), each after "label: " when a label is given (a method, in a comparison).
+std::string integrity_lines(const Metrics& m, const std::string& label = "");
 
 }  // namespace lidarloop

@@ -12,6 +12,7 @@
 #include "logs/ros2_messages.hpp"
 #include "loop/birdseye.hpp"
 #include "loop/error_plots.hpp"
+#include "loop/fault_events.hpp"
 #include "loop/result_files.hpp"
 #include "sim/sensor_calibration.hpp"
 
@@ -77,7 +78,9 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
                           const Path& route, const std::vector<TruthPose>& truth, const std::string& method,
                           const std::vector<EstimateRecord>& estimates, const WorstFrame* worst, const HdMap& map,
                           const std::vector<CurbVisibility>& curb_visibility) {
-  ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name, curb_visibility,
+  const std::vector<FaultEvent> events =
+      truth.empty() ? std::vector<FaultEvent>{} : fault_events(scenario, truth.front().stamp_ns);
+  ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name, events, curb_visibility,
                            scenario.lidar.scan_period_ns());
   scored.metrics.realism = realism_name(scenario.realism);
   scored.metrics.realism_overrides = realism_overrides(scenario);
@@ -91,7 +94,7 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
   write_tum(dir + "/estimate.tum", estimates);
   write_tum(dir + "/truth.tum", truth);
   write_junit(dir + "/junit.xml", {scored.metrics});
-  write_error_plot(dir + "/errors.png", scored.errors);
+  write_error_plot(dir + "/errors.png", scored.errors, events);
   write_trajectory_plot(dir + "/trajectory.png", truth, estimates, scored.errors, map.curbs.map().curbs);
   if (worst) write_worst_frame(dir + "/worst_frame.png", *worst, map, method);
   return scored;

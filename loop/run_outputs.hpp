@@ -27,7 +27,8 @@ std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate
 // the scenario, lane keeping along `route`, coverage by the scenario's LiDAR scan period), then
 // writes its files into `dir`: metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml,
 // errors.png, trajectory.png, and worst_frame.png when `worst` is given (else none). `realism`,
-// the mount error and the thresholds come from `scenario`. `curb_visibility`: the simulator's
+// the mount error, the thresholds and the fault events (loop/fault_events.hpp, from the first truth
+// stamp) come from `scenario`. `curb_visibility`: the simulator's
 // per-scan records (empty when not known). `run`, `compare`, `replay` and `score` all end here.
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthPose>& truth, const std::string& method,

@@ -12,6 +12,25 @@
 //   e_yaw  = wrap(psi_est - psi_gt)             positive: turned counter-clockwise from it
 // There is no trajectory alignment: the localizer estimates in the map's frame, which is the truth's,
 // so an offset between the two is an error to report, not a nuisance to fit away.
+//
+// Consistency: does the estimate's covariance P (x, y, yaw in the map frame) claim the accuracy it
+// has? Its x-y block is rotated into the same truth vehicle frame, with R = R(psi_gt) the rotation
+// from that frame to the map's:
+//   P_vehicle = R^T P_xy R,  R = [c -s; s c],  c = cos(psi_gt), s = sin(psi_gt), whose diagonal is
+//   s_long^2 = c^2 Pxx + 2 c s Pxy + s^2 Pyy,  s_lat^2 = s^2 Pxx - 2 c s Pxy + c^2 Pyy,  s_yaw^2 = P(2,2)
+// and each axis' normalised estimation error squared is NEES = e^2 / s^2 (e_lat^2 / s_lat^2, ...). For a
+// filter whose covariance is honest, each NEES is chi-square with one degree of freedom: mean 1, and
+// |e| > 3 s in 0.27 % of frames. Metrics average it per axis over the scored frames that are not
+// `lost` and whose variance on that axis is positive, beyond the rotation's round-off (NaN when there
+// are none: a TUM estimate has no covariance). A mean of 4 says the covariance claims twice the
+// accuracy the estimate has.
+//
+// Integrity: a frame is misleading when its estimate is not `lost` and its error exceeds a protection
+// bound it gave, |e_lat| > protection_lateral_m or |e_long| > protection_longitudinal_m (a frame
+// without both bounds, NaN, is neither misleading nor counted; an infinite bound is never exceeded).
+// It is available when it is not `lost` and both its bounds are under the scenario's alert limits
+// (PassThresholds). Both count every scored frame, the ones right after a fault included: those are
+// the frames integrity is about.
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -67,6 +86,48 @@ struct FrameError {
   int64_t stamp_ns = 0;
   double lateral_m = 0, longitudinal_m = 0, heading_rad = 0, position_m = 0;
   Pose2d truth, estimate;
+  // What the estimate claims about itself on the same axes: its standard deviations in the truth's
+  // vehicle frame (NaN where the variance is not positive), its protection bounds and `lost`.
+  double sigma_lateral_m = std::numeric_limits<double>::quiet_NaN();
+  double sigma_longitudinal_m = std::numeric_limits<double>::quiet_NaN();
+  double sigma_heading_rad = std::numeric_limits<double>::quiet_NaN();
+  double protection_lateral_m = std::numeric_limits<double>::quiet_NaN();
+  double protection_longitudinal_m = std::numeric_limits<double>::quiet_NaN();
+  bool lost = false;
+};
+
+// The consistency of a run's covariance (the convention above); NaN where no frame counts.
+struct Consistency {
+  double mean_nees_lateral = std::numeric_limits<double>::quiet_NaN();
+  double mean_nees_longitudinal = std::numeric_limits<double>::quiet_NaN();
+  double mean_nees_heading = std::numeric_limits<double>::quiet_NaN();
+  // Share of the frames counted on an axis whose error is beyond 3 sigma on it; `any`: of the frames
+  // with all three variances positive, those beyond 3 sigma on at least one axis.
+  double beyond_3_sigma_lateral = std::numeric_limits<double>::quiet_NaN();
+  double beyond_3_sigma_longitudinal = std::numeric_limits<double>::quiet_NaN();
+  double beyond_3_sigma_heading = std::numeric_limits<double>::quiet_NaN();
+  double beyond_3_sigma_any = std::numeric_limits<double>::quiet_NaN();
+  size_t frames = 0;  // not lost, all three variances positive
+};
+
+// Integrity (the convention above).
+struct Integrity {
+  size_t frames_with_bounds = 0;  // scored frames giving both protection bounds (infinite ones too)
+  size_t misleading_frames = 0;
+  double misleading_fraction = std::numeric_limits<double>::quiet_NaN();  // of frames_with_bounds
+  double availability = std::numeric_limits<double>::quiet_NaN();         // of all scored frames
+};
+
+// How the localizer came back from one event, each time in seconds from the event and measured on
+// the estimates from it until the next event (or the end), with the error each has whether it is
+// scored or settling; NaN when it did not happen in that window.
+struct EventRecovery {
+  FaultEvent event;
+  // To the first estimate from which the position error stays under recovery's position_m.
+  double converged_after_s = std::numeric_limits<double>::quiet_NaN();
+  // To the first estimate saying `lost`, and to the first after that one not saying it.
+  double lost_raised_after_s = std::numeric_limits<double>::quiet_NaN();
+  double lost_cleared_after_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct Metrics {
@@ -80,6 +141,9 @@ struct Metrics {
   size_t frames = 0;           // estimates scored
   size_t unscored_frames = 0;  // estimates outside the truth's time range (not scored, reported)
   size_t settling_frames = 0;  // estimates within thresholds.settle_s of the first (not scored)
+  // With thresholds.recovery set, the scored estimates within its within_s after a fault (not the
+  // start, which settle_s covers): kept out of the RMSEs and maxima, counted in consistency and integrity.
+  size_t recovery_frames = 0;
   double lateral_rmse_m = 0, longitudinal_rmse_m = 0, heading_rmse_deg = 0, position_rmse_m = 0;
   double max_position_error_m = 0, max_lateral_m = 0, max_longitudinal_m = 0, max_heading_deg = 0;  // absolute
   int64_t worst_frame_stamp_ns = 0;  // the frame with the largest position error (for a bird's-eye plot)
@@ -95,6 +159,9 @@ struct Metrics {
   // the run's visibility is not known, as in a replayed log without it).
   double curb_hidden_fraction = std::numeric_limits<double>::quiet_NaN();
   double curb_hidden_fraction_max = std::numeric_limits<double>::quiet_NaN();
+  Consistency consistency;
+  Integrity integrity;
+  std::vector<EventRecovery> recovery;  // one per event given to score(), in time order
   PassThresholds thresholds;
   bool pass = false;
   std::vector<std::string> failures;  // for people, e.g. "lateral RMSE 0.310 m > 0.200 m"
@@ -117,16 +184,36 @@ struct ScoredRun {
 // label the metrics. Passes when there is at least one scored frame and every threshold that is set
 // holds (a non-finite value never holds). Throws std::invalid_argument if the truth is not sorted by
 // stamp or the route has fewer than two points. `curb_visibility` (one record per scan, any order)
-// gives the curb occlusion figures; it is not scored against any threshold.
+// gives the curb occlusion figures; it is not scored against any threshold. `events` (any order;
+// loop/fault_events.hpp's from a scenario) give the recovery figures, by thresholds.recovery's
+// criteria or, unset, its defaults, and, when it is set, the recovery frames.
 ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates, const Path& route,
                 const PassThresholds& thresholds, const std::string& method, const std::string& scenario,
-                const std::vector<CurbVisibility>& curb_visibility = {},
+                const std::vector<FaultEvent>& events = {}, const std::vector<CurbVisibility>& curb_visibility = {},
                 int64_t scan_period_ns = Hdl32eConfig{}.scan_period_ns());
 
 // ---- Its parts, pure as well ----
 
-// The error of `estimate` against `truth` by the convention above; stamp_ns is left 0 for the caller.
+// The error of `estimate` against `truth` by the convention above; stamp_ns is left 0 for the caller
+// and the estimate's claims NaN (not given).
 FrameError frame_error(const Pose2d& truth, const Pose2d& estimate);
+// The same with the estimate's stamp and its claims (sigmas in the truth's frame, bounds, `lost`).
+FrameError estimate_error(const Pose2d& truth, const EstimateRecord& estimate);
+
+// e^2 / sigma^2; NaN when sigma is not positive (no variance claimed) or either is not finite.
+double nees(double error, double sigma);
+
+// Integrity of one frame and of a run, by the convention above.
+bool misleading(const FrameError& frame);
+bool available(const FrameError& frame, double alert_limit_lateral_m, double alert_limit_longitudinal_m);
+Integrity integrity(const std::vector<FrameError>& frames, double alert_limit_lateral_m,
+                    double alert_limit_longitudinal_m);
+Consistency consistency(const std::vector<FrameError>& frames);
+
+// One EventRecovery per event, in time order, from `frames` (sorted by stamp, each estimate in the
+// truth's range); `position_m` is the error a recovered estimate stays under.
+std::vector<EventRecovery> event_recovery(const std::vector<FrameError>& frames, std::vector<FaultEvent> events,
+                                          double position_m);
 
 // Truth at t by linear interpolation between the bracketing samples, the yaw interpolated along the
 // shorter arc. `truth` must be sorted by stamp. Throws std::out_of_range if t lies outside

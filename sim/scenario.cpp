@@ -13,6 +13,8 @@ namespace {
 constexpr double kMaxDuration = 24 * 3600;  // s
 constexpr double kMaxSpeed = 40;            // m/s for any actor
 constexpr double kPathCheckStep = 1.0;      // m between on-road checks
+constexpr double kMaxAlertLimit = 1e4;      // m, as the other distance thresholds of `pass`
+constexpr double kMaxNees = 1e6;            // a mean NEES bound beyond any filter worth gating
 
 std::vector<Wait> read_waits(const YamlReader& y, const YAML::Node& n, const char* what) {
   std::vector<Wait> out;
@@ -30,15 +32,32 @@ std::vector<Wait> read_waits(const YamlReader& y, const YAML::Node& n, const cha
 
 // A `pass` mapping over the values `pass` already holds.
 void read_pass(const YamlReader& y, const YAML::Node& n, PassThresholds& pass) {
-  YamlMap(y, n, "pass")
-      .number("lateral_rmse_m", pass.lateral_rmse_m, 0.0, 1e4)
+  YamlMap m(y, n, "pass");
+  m.number("lateral_rmse_m", pass.lateral_rmse_m, 0.0, 1e4)
       .number("longitudinal_rmse_m", pass.longitudinal_rmse_m, 0.0, 1e4)
       .number("heading_rmse_deg", pass.heading_rmse_deg, 0.0, 1e4)
       .number("max_position_error_m", pass.max_position_error_m, 0.0, 1e4)
       .number("max_lane_offset_m", pass.max_lane_offset_m, 0.0, 1e4)
       .number("settle_s", pass.settle_s, 0.0, 60.0)
       .number("min_coverage", pass.min_coverage, 0.0, 1.0)
-      .done();
+      .number("max_misleading_fraction", pass.max_misleading_fraction, 0.0, 1.0)
+      .number("min_availability", pass.min_availability, 0.0, 1.0)
+      .number("alert_limit_lateral_m", pass.alert_limit_lateral_m, 0.0, kMaxAlertLimit)
+      .number("alert_limit_longitudinal_m", pass.alert_limit_longitudinal_m, 0.0, kMaxAlertLimit)
+      .number("min_mean_nees", pass.min_mean_nees, 0.0, kMaxNees)
+      .number("max_mean_nees", pass.max_mean_nees, 0.0, kMaxNees);
+  if (const YAML::Node r = m["recovery"]) {
+    PassThresholds::Recovery recovery = pass.recovery.value_or(PassThresholds::Recovery{});
+    YamlMap(y, r, "recovery")
+        .number("position_m", recovery.position_m, 0.0, kMaxAlertLimit)
+        .number("within_s", recovery.within_s, 0.0, kMaxDuration)
+        .number("lost_within_s", recovery.lost_within_s, 0.0, kMaxDuration)
+        .done();
+    pass.recovery = recovery;
+  }
+  m.done();
+  if (pass.min_mean_nees && pass.max_mean_nees && *pass.min_mean_nees > *pass.max_mean_nees)
+    y.fail(m["min_mean_nees"] ? m["min_mean_nees"] : m["max_mean_nees"], "min_mean_nees is above max_mean_nees");
 }
 
 // One of two words, as a bool: true for `yes`.

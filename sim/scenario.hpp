@@ -64,6 +64,12 @@ struct EgoSpec {
   ControllerParams controller;
 };
 
+// The default alert limits (PassThresholds), lateral and longitudinal alike: Reid et al., "Localization
+// Requirements for Autonomous Vehicles", SAE Int. J. CAV 2(3):173-190, 2019, derive error bounds
+// (alert limits) of 0.29 m (0.10 m at 95 %) for a passenger vehicle on local streets, the roads the
+// suite drives (0.57 m lateral, 1.40 m longitudinal on freeways).
+constexpr double kLocalStreetAlertLimit_m = 0.29;
+
 struct PassThresholds {
   std::optional<double> lateral_rmse_m, longitudinal_rmse_m, heading_rmse_deg, max_position_error_m;
   // How far the car's true rear axle may stray from its lane's centre (closed loop: the controller
@@ -76,6 +82,23 @@ struct PassThresholds {
   // an estimate that starts late, stops early or has gaps is scored on what exists, and this says
   // how much must exist.
   std::optional<double> min_coverage;
+  // Integrity and consistency (loop/scorer.hpp defines each figure). The alert limits are what a
+  // protection bound must stay under for its frame to count as available.
+  std::optional<double> max_misleading_fraction, min_availability;
+  double alert_limit_lateral_m = kLocalStreetAlertLimit_m, alert_limit_longitudinal_m = kLocalStreetAlertLimit_m;
+  // Each axis' mean NEES must lie within [min_mean_nees, max_mean_nees] when set.
+  std::optional<double> min_mean_nees, max_mean_nees;
+  // Recovery from the run's start and its faults (loop/fault_events.hpp): `position_m` is the error
+  // a recovered estimate stays under; when set, every event must recover within `within_s` and every
+  // fault raise `lost` within `lost_within_s` and clear it before the next event, and the frames
+  // within `within_s` after a fault are kept out of the accuracy metrics. Unset, the defaults still
+  // define the recovery figures reported.
+  struct Recovery {
+    // The suite's goal for its cold-start and fault scenarios: under 0.3 m within 3 s of the start or
+    // the fault, `lost` raised within 1 s of the fault.
+    double position_m = 0.3, within_s = 3.0, lost_within_s = 1.0;
+  };
+  std::optional<Recovery> recovery;
 };
 
 // Thresholds given apart from a scenario (`lidarloop score`), read as strictly as a scenario's

@@ -116,6 +116,7 @@ int run_run(const Args& args) {
   std::printf("obstacles  in the corridor in %zu of %zu scans (%.0f%%)\n", with_obstacles, trace.estimates.size(),
               100.0 * double(with_obstacles) / double(std::max<size_t>(trace.estimates.size(), 1)));
   std::printf("curbs      %s\n", curb_occlusion_text(scored.metrics).c_str());
+  std::cout << integrity_lines(scored.metrics);
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
       "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
@@ -216,6 +217,7 @@ int run_compare(const Args& args) {
                 metrics.size());
     print_realism(s.scenario);
     if (!metrics.empty()) std::printf("curbs      %s\n", curb_occlusion_text(metrics.front()).c_str());  // one drive
+    for (const Metrics& m : metrics) std::cout << integrity_lines(m, m.method);
     std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, <method>/...)\n", out.c_str());
     return expect ? expect_best(metrics, *expect) : 0;
   }

@@ -13,6 +13,7 @@
 #include "logs/log_topics.hpp"
 #include "logs/tum_file.hpp"
 #include "loop/estimate_file.hpp"
+#include "loop/fault_events.hpp"
 #include "loop/localizer_setup.hpp"
 #include "loop/recorded_log.hpp"
 #include "loop/result_files.hpp"
@@ -88,10 +89,10 @@ int run_score(const Args& args) {
   const std::string method = args.text("method", std::filesystem::path(*estimate_path).stem().string());
   const std::string out = args.text("out", "out/" + name + "-score");
   // Scored once to find the worst frame (pure and quick), then again where the files are written.
-  const std::optional<WorstFrame> worst =
-      worst_frame(log, scenario, truth,
-                  score(truth, estimate.estimates, resolved.ego_route, scenario.pass, method, name,
-                        recorded.curb_visibility, scenario.lidar.scan_period_ns()));
+  const std::optional<WorstFrame> worst = worst_frame(
+      log, scenario, truth,
+      score(truth, estimate.estimates, resolved.ego_route, scenario.pass, method, name,
+            fault_events(scenario, truth.front().stamp_ns), recorded.curb_visibility, scenario.lidar.scan_period_ns()));
   const ScoredRun scored = score_and_write(out, name, scenario, resolved.ego_route, truth, method, estimate.estimates,
                                            worst ? &*worst : nullptr, map, recorded.curb_visibility);
   const Metrics& m = scored.metrics;
@@ -111,6 +112,7 @@ int run_score(const Args& args) {
               double(scenario.lidar.scan_period_ns()) / 2e6, m.largest_gap_s);
   std::printf("latency    not known from a file: null in metrics.json\n");
   std::printf("curbs      %s\n", curb_occlusion_text(m).c_str());
+  std::cout << integrity_lines(m);
   for (const auto& f : m.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
       "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "

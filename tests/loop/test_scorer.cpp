@@ -248,7 +248,7 @@ TEST(CurbOcclusion, HiddenOverInSightSummedOverScansAndTheWorstScan) {
 }
 
 TEST(CurbOcclusion, ScoreCarriesItIntoTheMetricsAndTheirJson) {
-  const Metrics m = score(straight_truth(1), offset_estimates(1, 0, 0, 0), straight_route(), {}, "m", "s",
+  const Metrics m = score(straight_truth(1), offset_estimates(1, 0, 0, 0), straight_route(), {}, "m", "s", {},
                           {{0, 30, 10, 0}, {100 * kMs, 20, 40, 0}})
                         .metrics;
   EXPECT_DOUBLE_EQ(m.curb_hidden_fraction, 0.5);
@@ -426,11 +426,11 @@ TEST(ErrorPlots, WritePngsOfTheRequestedSize) {
     EXPECT_EQ(image.rows, 900);
   }
   // Other sizes, and degenerate inputs draw rather than crash.
-  write_error_plot(errors_png, {}, {800, 600});
+  write_error_plot(errors_png, {}, {}, {800, 600});
   EXPECT_EQ(cv::imread(errors_png).cols, 800);
   write_trajectory_plot(trajectory_png, {}, {}, {}, {}, {640, 480});
   EXPECT_EQ(cv::imread(trajectory_png).rows, 480);
-  EXPECT_THROW(write_error_plot(errors_png, run.errors, {100, 100}), InputError);
+  EXPECT_THROW(write_error_plot(errors_png, run.errors, {}, {100, 100}), InputError);
 }
 
 TEST(Score, SettlingFramesAreNotScoredAndLaneKeepingIsChecked) {
