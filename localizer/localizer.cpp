@@ -176,7 +176,8 @@ Localizer::Localizer(HdMap& map, const LocalizerParams& params)
       accumulator_(params.curb_features.frames),
       intensity_calibration_(params.intensity_calibration),
       lost_(params.lost),
-      gps_steps_(params.gps_steps) {}
+      gps_steps_(params.gps_steps),
+      relocalizer_(params.relocalization) {}
 
 void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance) {
   predict_to(stamp_ns);
@@ -258,9 +259,10 @@ void Localizer::on_gps(const GpsFix& fix) {
     }
     return;
   }
+  if (lost_.searching()) return;  // the search spans the GPS's doubt, and corrections would move its prior
   if (lost_.lost()) {
-    // While lost the filter itself moves by metres, so steps say nothing new; only the fixes that
-    // stepped before (the GPS may be what jumped) wait for the map's verdict.
+    // A pose found, being confirmed: the filter itself moves, so steps say nothing new; only the fixes
+    // that stepped before (the GPS may be what jumped) wait for the confirmation.
     if (!(gps_stepped_ && stepped))
       filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
     return;
@@ -356,19 +358,26 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
   if (uses_intensity(method))  // 2.2.2
     S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, intensity_calibration_, e);
 
-  if (uses_curbs(method)) {
-    const std::optional<PoseObservation> z = match_curbs(features_.curbs, e);  // 3.1
-    if (z) fuse_curbs(*z, e);                                                  // 3.3
-  }
-  if (S && lost_.searching()) {
-    relocalize(*S, e);
-  } else if (S) {
-    const std::optional<ApsResult> z = match_intensity(*S, e);  // 3.2
-    if (z) fuse_intensity(*z, e);                               // 3.3
+  if (lost_.searching()) {
+    relocalize(S ? &*S : nullptr, e);
+  } else {
+    match_and_fuse(S ? &*S : nullptr, e);
   }
   if (map_calibration) {
     const StageTimer timer(stage_ms(e, Stage::intensity_matching));
     calibrate_lasers_to_the_map(points, ground);
+  }
+}
+
+// 3.1-3.3: the curbs, then APS around the pose the curb update left.
+void Localizer::match_and_fuse(IntensityGrid* S, LocalizerEstimate& e) {
+  if (uses_curbs(params_.method)) {
+    const std::optional<PoseObservation> z = match_curbs(features_.curbs, e);  // 3.1
+    if (z) fuse_curbs(*z, e);                                                  // 3.3
+  }
+  if (S) {
+    const std::optional<ApsResult> z = match_intensity(*S, e);  // 3.2
+    if (z) fuse_intensity(*z, e);                               // 3.3
   }
 }
 
@@ -692,41 +701,57 @@ void Localizer::widen_to(const std::deque<Disagreement>& refused) {
                        .asDiagonal());
 }
 
-// While lost: APS over the filter's whole spread (window_sigmas of it, within the bounds). A distinct
-// peak moves the filter there with APS's covariance, to be confirmed by the next matches; a broad or
-// edge-bound one leaves it for the next scan.
-void Localizer::relocalize(IntensityGrid& S, LocalizerEstimate& e) {
+// While lost: a share of the wide searches (relocalization.hpp) over the window the filter's spread
+// spans; the filter moves to what they find. The narrow matchers wait: their corrections would move the
+// prior under the search's feet.
+void Localizer::relocalize(IntensityGrid* S, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::intensity_matching));
   e.wide_search = true;
-  const Pose2d before = filter_->pose();
-  S.pose = before;
+  const Pose2d prior = filter_->pose();
+  if (!relocalizer_.active()) start_relocalization();
+  std::vector<Eigen::Vector2d> curbs_world;
+  if (uses_curbs(params_.method))
+    for (const auto& f : features_.curbs) curbs_world.push_back(vehicle_to_world(prior, f));
+  const LocalCurbs local = local_curbs(map_.curbs, xy(prior), params_.map_window_m);
+  const std::optional<Relocation> found =
+      relocalizer_.step(uses_intensity(params_.method) ? S : nullptr, map_.intensity, curbs_world, local.index, prior);
+  if (found) move_to(*found);
+}
+
+void Localizer::start_relocalization() {
   const RelocalizationParams& r = params_.relocalization;
-  const double c = std::cos(before.yaw), s = std::sin(before.yaw);
-  Eigen::Matrix2d to_vehicle;
-  to_vehicle << c, s, -s, c;
-  const Eigen::Matrix2d spread = to_vehicle * filter_->covariance().topLeftCorner<2, 2>() * to_vehicle.transpose();
-  ApsParams aps = params_.aps;
-  auto range = [&](double variance, double max_range) {
-    const double wanted = std::clamp(r.window_sigmas * std::sqrt(std::max(variance, 0.0)), r.min_range_m,
-                                     std::max(r.min_range_m, max_range));
-    return std::floor(wanted / aps.step_m + kWholeStepTolerance) * aps.step_m;
+  const Pose2d prior = filter_->pose();
+  const Eigen::Matrix3d P = filter_->covariance();
+  const Eigen::Vector2d forward(std::cos(prior.yaw), std::sin(prior.yaw)), left(-forward.y(), forward.x());
+  const Eigen::Vector3d sigmas(std::sqrt(forward.dot(P.topLeftCorner<2, 2>() * forward)),
+                               std::sqrt(left.dot(P.topLeftCorner<2, 2>() * left)), std::sqrt(P(2, 2)));
+  auto half = [&](double sigma, double max_range) {
+    return std::clamp(r.window_sigmas * sigma, std::min(r.min_range_m, max_range), max_range);
   };
-  aps.longitudinal_range_m = range(spread(0, 0), r.max_longitudinal_m);
-  aps.lateral_range_m = range(spread(1, 1), r.max_lateral_m);
-  const ApsResult found = aps_match(S, map_.intensity, aps);
-  e.intensity_cells = found.cells_used;
-  if (!found.ok || found.peak_on_edge || found.spread_ratio.maxCoeff() > params_.aps_max_spread_ratio) return;
-  e.intensity_observation = found.position;
-  Eigen::Matrix3d covariance = filter_->covariance();
-  covariance.topLeftCorner<2, 2>() = found.covariance * params_.aps_covariance_scale;
-  covariance.block<2, 1>(0, 2).setZero();
-  covariance.block<1, 2>(2, 0).setZero();
-  filter_.emplace(Pose2d{found.position.x(), found.position.y(), before.yaw}, covariance, params_.filter);
+  const Eigen::Vector3d ranges(half(sigmas.x(), r.max_longitudinal_m), half(sigmas.y(), r.max_lateral_m),
+                               std::min(r.window_sigmas * sigmas.z(), r.max_yaw_deg / kDegPerRad));
+  relocalizer_.start(ranges, ranges / r.window_sigmas);
+}
+
+void Localizer::move_to(const Relocation& found) {
+  relocalizer_.stop();
+  Eigen::Matrix3d covariance = found.covariance;
+  if (!found.longitudinal) {
+    // The filter's doubt along the road stays; across it and in heading, the search's.
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    R.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(found.pose.yaw).toRotationMatrix();
+    const Eigen::Matrix3d old_vehicle = R.transpose() * filter_->covariance() * R;
+    const Eigen::Matrix3d new_vehicle = R.transpose() * found.covariance * R;
+    covariance =
+        R * Eigen::Vector3d(old_vehicle(0, 0), new_vehicle(1, 1), new_vehicle(2, 2)).asDiagonal() * R.transpose();
+  }
+  filter_.emplace(found.pose, covariance, params_.filter);
+  if (!found.longitudinal) return;  // still lost: the next scan searches again, narrower across
   lost_.found();
   // Who jumped? If the map found the car about where the filter had it, the GPS did: it is rejected
   // until it steps back (its level is learnt anew once the pose is confirmed).
   if (gps_stepped_ && pose_when_lost_ && last_gps_step_) {
-    const double moved = (found.position - xy(*pose_when_lost_)).norm();
+    const double moved = (xy(found.pose) - xy(*pose_when_lost_)).norm();
     if (moved < 0.5 * last_gps_step_->norm()) gps_fault_level_ = gps_steps_.level();
   }
   gps_stepped_ = false;

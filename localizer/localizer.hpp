@@ -34,6 +34,7 @@
 #include "localizer/intensity_calibration.hpp"
 #include "localizer/localizer_params.hpp"
 #include "localizer/lost_detector.hpp"
+#include "localizer/relocalization.hpp"
 
 namespace lidarloop {
 
@@ -171,8 +172,12 @@ class Localizer {
   bool pose_known_to_calibrate() const;
   void calibrate_lasers_to_each_other(const ScanPoints& points, const std::vector<size_t>& ground);
   void calibrate_lasers_to_the_map(const ScanPoints& points, const std::vector<size_t>& ground);
-  // While lost: the wide search (relocalization) with this scan's S; the filter moves to what it finds.
-  void relocalize(IntensityGrid& S, LocalizerEstimate& e);
+  void match_and_fuse(IntensityGrid* S, LocalizerEstimate& e);
+  // While lost: a share of the wide search (relocalization) with this scan's S and curbs; the filter
+  // moves to what it finds.
+  void relocalize(IntensityGrid* S, LocalizerEstimate& e);
+  void start_relocalization();
+  void move_to(const Relocation& found);
   // The filter admits the doubt that made it lost: its spread grows to cover where the refused
   // observations put the car, so the wide search's window (and a bound) covers it.
   void widen_to(const std::deque<Disagreement>& refused);
@@ -209,6 +214,7 @@ class Localizer {
 
   LostDetector lost_;
   GpsStepDetector gps_steps_;
+  Relocalizer relocalizer_;
   bool gps_stepped_ = false;  // the GPS's disagreement that made the localizer lost was a step
   // Set while the GPS is rejected (kGpsRejected): the innovation level it had before it jumped.
   std::optional<Eigen::Vector2d> gps_fault_level_;

@@ -24,6 +24,7 @@
 #include "localizer/pose_filter.hpp"
 #include "localizer/probabilistic_icp.hpp"
 #include "localizer/protection_bound.hpp"
+#include "localizer/relocalization.hpp"
 
 namespace lidarloop {
 
@@ -47,20 +48,6 @@ struct HealthParams {
   double gate_gps = 13.82;
   int max_rejections = 10;
   double max_inflated_sigma_m = 2.0;
-};
-
-// The wide search while lost (beyond the paper). Its window is the filter's spread, which on becoming
-// lost grows to cover where the refused observations put the car, within these bounds.
-struct RelocalizationParams {
-  double window_sigmas = 3.0;
-  // The farthest refused observation's offset counts as this many sigmas of the lost filter's spread:
-  // the window then reaches half as far again beyond it, and the truth is not at its edge.
-  double lost_offset_sigmas = 2.0;
-  double min_range_m = 2.0;  // half extent on each axis, at least
-  double max_longitudinal_m = 8.0, max_lateral_m = 6.0;
-  // The heading doubt a lost filter admits (1 sigma, deg): the paper's receiver's heading error
-  // (1.5-2 deg), which is all a cold start or a kidnapped filter can vouch for.
-  double lost_yaw_sigma_deg = 1.5;
 };
 
 struct GpsNoise {

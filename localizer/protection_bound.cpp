@@ -7,8 +7,7 @@
 namespace lidarloop {
 
 double normal_two_sided_quantile(double probability) {
-  if (!(probability > 0 && probability < 1))
-    throw std::invalid_argument("integrity probability must lie in (0, 1)");
+  if (!(probability > 0 && probability < 1)) throw std::invalid_argument("integrity probability must lie in (0, 1)");
   // P(|N| > k) = erfc(k / sqrt 2), decreasing in k: bisection to well below any use's precision.
   double lo = 0, hi = 40;
   for (int i = 0; i < 200; ++i) {

@@ -1,0 +1,90 @@
+#pragma once
+// Relocalization (beyond the paper): while the localizer is lost, the wide searches of intensity
+// (wide_search.hpp: APS over x, y and yaw, coarse to fine) and curbs (curb_hypotheses.hpp: ICP from a
+// grid of starts) run over the window the filter's doubt spans, a share per scan, and decide where the
+// car is. Each scan runs one of the two (taking turns when both have data), so a scan stays within the
+// localizer's budget; a search over +-6 m and +-4 deg takes about five shares.
+//
+// What a finished search may claim:
+//   - all of x, y and yaw when its best place beats every other distinct place clearly (APS: by
+//     min_aps_margin in Eq. 14's log probability, the GPS prior's Gaussian included; curbs: no other
+//     place fits as well on any axis);
+//   - only the lateral position and the heading when the other places that fit as well lie along the
+//     road from the best (dashed lines repeat every few metres, straight curbs say nothing along it),
+//     unless for APS the prior (the GPS) alone rules the other place out;
+//     The localizer stays lost then, and searches again from the corrected pose.
+// Anything else is refused, and the search starts again on the next scans.
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/pose2d.hpp"
+#include "localizer/curb_hypotheses.hpp"
+#include "localizer/map_index.hpp"
+#include "localizer/wide_search.hpp"
+
+namespace lidarloop {
+
+struct RelocalizationParams {
+  // The search window is this many sigmas of the filter's spread on each axis of the car...
+  double window_sigmas = 3.0;
+  // On becoming lost the filter's spread grows so that the farthest observation it refused (the truth
+  // may be there) lies this many sigmas out: the window then reaches half as far again beyond it.
+  double lost_offset_sigmas = 2.0;
+  double min_range_m = 2.0;  // half extent on each axis, at least
+  double max_longitudinal_m = 8.0, max_lateral_m = 6.0;
+  // The heading doubt of a lost filter (1 sigma, deg): the paper's receiver's heading error (1.5-2 deg),
+  // which is all a cold start or a kidnapped filter can vouch for; and the most searched.
+  double lost_yaw_sigma_deg = 1.5;
+  double max_yaw_deg = 6.0;
+  double min_curb_score = 0.5;  // curb places explaining less (curb_hypotheses.hpp's score) are refused
+  // APS's best must beat the best distinct other place by this much log probability (Eq. 14 with the
+  // prior). Stripes repeating every 3 m measured ~40 (ambiguous), paint across the road 370-1200.
+  double min_aps_margin = 100.0;
+  // Along the road, the best of repeating paint is taken when the prior alone makes the other place this
+  // much less likely (half the squared sigmas: 4.5 is 3 sigma farther out).
+  double min_prior_gap = 4.5;
+  // The places that fit as well lie along the road when they are within this of the best across it
+  // (m) and in heading (deg): the lateral and the heading are then fixed.
+  double along_road_lateral_m = 0.4, along_road_yaw_deg = 0.5;
+  WideApsParams aps;      // its ranges are set per search
+  CurbHypothesesParams curbs;
+};
+
+struct Relocation {
+  Pose2d pose;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // x, y, psi; local frame
+  bool longitudinal = true;  // false: only the lateral position and the heading are fixed
+};
+
+class Relocalizer {
+ public:
+  explicit Relocalizer(const RelocalizationParams& params = {}) : p_(params) {}
+
+  // A new search around the prior over half ranges (longitudinal m, lateral m, yaw rad; vehicle frame),
+  // with the prior's sigmas on those axes for Eq. 14's prior term.
+  void start(const Eigen::Vector3d& half_ranges, const Eigen::Vector3d& prior_sigmas);
+  bool active() const { return active_; }
+  void stop() { active_ = false; }
+  // One share. `S` (at `prior`, or null), the curb features placed at `prior` (world frame) with the
+  // map's curbs around it (or empty). A relocation when a search has finished and found one.
+  std::optional<Relocation> step(IntensityGrid* S, IntensityMap& intensity, const std::vector<Eigen::Vector2d>& curbs,
+                                 const MapIndex& curb_map, const Pose2d& prior);
+
+ private:
+  std::optional<Relocation> verdict(const WideApsResult& r, const Pose2d& prior) const;
+  std::optional<Relocation> verdict(const CurbHypothesesResult& r, const Pose2d& prior) const;
+
+  RelocalizationParams p_;
+  bool active_ = false;
+  bool curbs_turn_ = false;
+  Eigen::Vector3d prior_sigmas_ = Eigen::Vector3d::Ones();
+  WideApsSearch aps_;
+  CurbHypothesisSearch curbs_;
+};
+
+// Lateral position and heading of `found`, longitudinal position of `prior` (found's vehicle frame).
+Pose2d lateral_and_heading(const Pose2d& found, const Pose2d& prior);
+
+}  // namespace lidarloop
