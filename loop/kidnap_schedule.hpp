@@ -1,0 +1,37 @@
+#pragma once
+// The scenario's kidnaps (`faults:`, sim/scenario.hpp's KidnapFault) as the localizer meets them:
+// each moves its pose (Localizer::displace) just before the first scan stamped at or after the
+// kidnap's time. The scan's stamp is what the live loop, `replay` (from the log) and the benchmark
+// all have, so all three kidnap before the same scan and a replay stays bit-exact. Scenario seconds
+// count from the start of the run on the reference clock; a scan's stamp is the LiDAR clock's
+// (sim/clocks.hpp), within a few milliseconds of it, so a kidnap due at a scan's very start may fall
+// to the next scan, the same one in every run of that seed.
+#include <cstdint>
+#include <vector>
+
+#include "common/pose2d.hpp"
+#include "localizer/localizer_params.hpp"
+#include "sim/scenario.hpp"
+
+namespace lidarloop {
+
+class KidnapSchedule {
+ public:
+  KidnapSchedule() = default;
+  explicit KidnapSchedule(std::vector<KidnapFault> kidnaps);
+
+  // The offsets (x forward, y left in the localizer's vehicle frame; yaw added) of the kidnaps due
+  // at a scan stamped `scan_stamp_ns` and not handed out before, in order of time.
+  std::vector<Pose2d> due(int64_t scan_stamp_ns);
+  bool empty() const { return kidnaps_.empty(); }
+
+ private:
+  std::vector<KidnapFault> kidnaps_;  // by time
+  size_t next_ = 0;                   // the first not yet handed out
+};
+
+// An external program's pose cannot be moved from outside (its protocol has no such message), so a
+// scenario with kidnaps needs a built-in method: InputError naming the scenario otherwise.
+void check_kidnaps_supported(const Scenario& scenario, const LocalizerParams& params);
+
+}  // namespace lidarloop
