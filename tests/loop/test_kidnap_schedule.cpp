@@ -1,0 +1,47 @@
+// The scenario's kidnaps in the loop's time: each handed out once, at the first scan stamped at or
+// after it, in order of time; none for an external program, whose pose cannot be moved.
+#include <gtest/gtest.h>
+
+#include "common/input_error.hpp"
+#include "loop/kidnap_schedule.hpp"
+
+namespace lidarloop {
+namespace {
+
+TEST(KidnapSchedule, HandsEachKidnapOutOnceAtTheFirstScanFromItsTime) {
+  // Out of order in the file, two at the same time (done in file order).
+  KidnapSchedule s({{2.0, {1, 0}, 0.1}, {0.5, {0, 1}, 0}, {2.0, {0, 0}, -0.2}});
+  EXPECT_TRUE(s.due(400'000'000).empty());
+  const std::vector<Pose2d> first = s.due(500'000'000);  // exactly at its time
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_EQ(first[0].y, 1.0);
+  EXPECT_TRUE(s.due(600'000'000).empty());  // not twice
+  const std::vector<Pose2d> both = s.due(2'050'000'000);
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_EQ(both[0].x, 1.0);
+  EXPECT_EQ(both[0].yaw, 0.1);
+  EXPECT_EQ(both[1].yaw, -0.2);
+  EXPECT_TRUE(s.due(9'000'000'000).empty());
+  EXPECT_TRUE(KidnapSchedule().empty());
+}
+
+TEST(KidnapSchedule, AnExternalProgramCannotBeKidnapped) {
+  Scenario scenario;
+  scenario.file = "kidnap.yaml";
+  LocalizerParams external;
+  external.external.command = {"my_localizer"};
+  EXPECT_NO_THROW(check_kidnaps_supported(scenario, external));  // no kidnap: anything goes
+  scenario.kidnaps = {{8.0, {3.5, -2.0}, 0.03}};
+  EXPECT_NO_THROW(check_kidnaps_supported(scenario, LocalizerParams{}));
+  try {
+    check_kidnaps_supported(scenario, external);
+    ADD_FAILURE() << "an external program was kidnapped";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("kidnap.yaml: faults: kidnap needs a built-in localizer method"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace lidarloop
