@@ -115,7 +115,7 @@ int compare(const std::string& mcap, const std::string& json_path) {
 
   if (failures == 0)
     std::cout << "the Node.js reader agrees with the writer: " << node.at("counts").size() << " topics, "
-              << run.scans.size() << " scans, first and last points of the first scan\n";
+              << run.scans.size() << " scans, first and last points of the first scan, the first lost localizer status\n";
   return failures == 0 ? 0 : 1;
 }
 
