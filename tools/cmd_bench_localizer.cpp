@@ -89,15 +89,14 @@ int bench_localizer(const Args& args) {
     Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), sim_threads);
     sim.run(recorded);
   }
-  const nlohmann::json result = {
-      {"benchmark", "localizer"},
-      {"scenario", s.scenario.file},
-      {"method", method_name(params.method)},
-      {"scans", recorded.scans},
-      {"budget_ms", {{"p50", 8.0}, {"p99", 20.0}}},
-      {"runs",
-       {replay(recorded.messages, map_1, params, KidnapSchedule(s.scenario.kidnaps), 1),
-        replay(recorded.messages, map_2, params, KidnapSchedule(s.scenario.kidnaps), 2)}}};
+  const nlohmann::json result = {{"benchmark", "localizer"},
+                                 {"scenario", s.scenario.file},
+                                 {"method", method_name(params.method)},
+                                 {"scans", recorded.scans},
+                                 {"budget_ms", {{"p50", 8.0}, {"p99", 20.0}}},
+                                 {"runs",
+                                  {replay(recorded.messages, map_1, params, KidnapSchedule(s.scenario.kidnaps), 1),
+                                   replay(recorded.messages, map_2, params, KidnapSchedule(s.scenario.kidnaps), 2)}}};
   std::cout << result.dump(2) << "\n";
   return 0;
 }

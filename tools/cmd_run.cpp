@@ -89,8 +89,8 @@ int run_run(const Args& args) {
   const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_label(params), s.scenario.duration_s};
   std::function<void(const LocalizerEstimate&)> log_estimate;
   if (recorder) log_estimate = [&](const LocalizerEstimate& e) { record_estimate(recorder->log(), e); };
-  const LoopResult r = run_localizer_loop(sim, map, {params}, s.scenario.closed_loop, recorder.get(),
-                                          std::ref(progress), log_estimate);
+  const LoopResult r =
+      run_localizer_loop(sim, map, {params}, s.scenario.closed_loop, recorder.get(), std::ref(progress), log_estimate);
   if (recorder) recorder->log().close();
   progress.clear();
 

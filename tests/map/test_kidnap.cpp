@@ -17,7 +17,7 @@ namespace {
 
 constexpr double kKidnapS = 1.2;
 constexpr int64_t kScanPeriodNs = 100'000'000;  // the HDL-32E at its default 10 Hz
-const Eigen::Vector2d kOffset(3.0, -2.0);  // m, forward and left
+const Eigen::Vector2d kOffset(3.0, -2.0);       // m, forward and left
 constexpr double kYawDeg = 2.0;
 
 // The scenario's world once for both drives (building it is most of the test's time).

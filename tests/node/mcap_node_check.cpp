@@ -91,10 +91,10 @@ int compare(const std::string& mcap, const std::string& json_path) {
   if (lost == run.estimates.end() || status.is_null()) {
     expect_equal("a lost status", status.is_null(), lost == run.estimates.end());
   } else {
-    expect_equal("lost status stamp",
-                 status.at("stamp").at("sec").get<int64_t>() * 1'000'000'000 +
-                     status.at("stamp").at("nanosec").get<int64_t>(),
-                 lost->stamp_ns);
+    expect_equal(
+        "lost status stamp",
+        status.at("stamp").at("sec").get<int64_t>() * 1'000'000'000 + status.at("stamp").at("nanosec").get<int64_t>(),
+        lost->stamp_ns);
     expect_equal("lost status level", status.at("level").get<int>(), int(lost->status.level));
     expect_equal("lost status name", status.at("name").get<std::string>(), std::string(kLocalizerStatusName));
     expect_equal("lost status message", status.at("message").get<std::string>(), lost->status.health);
@@ -115,7 +115,8 @@ int compare(const std::string& mcap, const std::string& json_path) {
 
   if (failures == 0)
     std::cout << "the Node.js reader agrees with the writer: " << node.at("counts").size() << " topics, "
-              << run.scans.size() << " scans, first and last points of the first scan, the first lost localizer status\n";
+              << run.scans.size()
+              << " scans, first and last points of the first scan, the first lost localizer status\n";
   return failures == 0 ? 0 : 1;
 }
 
