@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cstdio>
 #include <map>
+#include <string_view>
 
 #include "common/input_error.hpp"
 #include "logs/log_topics.hpp"
@@ -48,11 +49,11 @@ class Values {
   }
   uint32_t flags(const std::string& key) const {
     const std::string& v = text(key);
+    const std::string_view prefix = "0x";
+    if (v.size() <= prefix.size() || v.rfind(prefix, 0) != 0) fail(key, v, "a hexadecimal number (0x...)");
     uint32_t out = 0;
-    const char* first = v.data() + 2;
-    const auto [end, ec] = std::from_chars(first, v.data() + v.size(), out, kHexBase);
-    if (v.rfind("0x", 0) != 0 || ec != std::errc() || end != v.data() + v.size() || end == first)
-      fail(key, v, "a hexadecimal number (0x...)");
+    const auto [end, ec] = std::from_chars(v.data() + prefix.size(), v.data() + v.size(), out, kHexBase);
+    if (ec != std::errc() || end != v.data() + v.size()) fail(key, v, "a hexadecimal number (0x...)");
     return out;
   }
 

@@ -236,7 +236,7 @@ TEST(LocalizerStatus, RoundTripsExactlyAsADiagnosticArray) {
   ros2::DiagnosticArray other = array;
   other.status[0].name = "lidar driver";
   EXPECT_FALSE(decode_localizer_status(ros2::encode_diagnostic_array(other), "test").has_value());
-  const std::vector<std::pair<size_t, std::string>> bad = {{0, "41"},   {0, "0x"},  {1, "yes"},
+  const std::vector<std::pair<size_t, std::string>> bad = {{0, "41"},   {0, "0x"},  {0, "4"}, {1, "yes"},
                                                            {2, "-0.5"}, {3, "1 m"}, {4, ""}};
   for (const auto& [index, value] : bad) {
     ros2::DiagnosticArray edited = array;
