@@ -3,7 +3,7 @@
 namespace lidarloop {
 
 LocalizerBackend::LocalizerBackend(HdMap& map, const LocalizerParams& params, const Scenario& scenario)
-    : label_(method_label(params)), kidnaps_(scenario.kidnaps) {
+    : label_(method_label(params)), kidnaps_(scenario) {
   check_kidnaps_supported(scenario, params);  // before an external program is started
   if (params.external.command.empty())
     builtin_ = std::make_unique<Localizer>(map, params);

@@ -95,8 +95,8 @@ int bench_localizer(const Args& args) {
                                  {"scans", recorded.scans},
                                  {"budget_ms", {{"p50", 8.0}, {"p99", 20.0}}},
                                  {"runs",
-                                  {replay(recorded.messages, map_1, params, KidnapSchedule(s.scenario.kidnaps), 1),
-                                   replay(recorded.messages, map_2, params, KidnapSchedule(s.scenario.kidnaps), 2)}}};
+                                  {replay(recorded.messages, map_1, params, KidnapSchedule(s.scenario), 1),
+                                   replay(recorded.messages, map_2, params, KidnapSchedule(s.scenario), 2)}}};
   std::cout << result.dump(2) << "\n";
   return 0;
 }
