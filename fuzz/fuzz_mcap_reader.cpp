@@ -6,6 +6,7 @@
 
 #include "common/input_error.hpp"
 #include "fuzz/fuzz_support.hpp"
+#include "logs/localizer_status.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/ros2_messages.hpp"
 
@@ -28,6 +29,7 @@ const std::map<std::string, Decoder>& decoders() {
       {"geometry_msgs/msg/PoseStamped", [](auto v, auto& c) { ros2::decode_pose_stamped(v, c); }},
       {"tf2_msgs/msg/TFMessage", [](auto v, auto& c) { ros2::decode_tf(v, c); }},
       {"velodyne_msgs/msg/VelodyneScan", [](auto v, auto& c) { ros2::decode_velodyne_scan(v, c); }},
+      {"diagnostic_msgs/msg/DiagnosticArray", [](auto v, auto& c) { decode_localizer_status(v, c); }},
   };
   return by_type;
 }

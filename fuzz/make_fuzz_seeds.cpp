@@ -62,7 +62,14 @@ void record_log(const std::string& path, McapWriterOptions options) {
     log.write_scan(cloud);
     log.write_velodyne_scan(seed_rotation(t));
     log.write_actors(t, {ros2::ActorState{"bus0", "bus", Pose2d{5.0 + i, 3.5, 0}}});
-    log.write_estimate(t, Pose2d{1.0 * i + 0.02, 0.49, 0.01 * i}, Eigen::Matrix3d::Identity() * 0.01);
+    // The last scan lost, so the seed holds both an infinite and a finite protection bound.
+    LocalizerStatus status;
+    status.stamp_ns = t;
+    status.lost = i + 1 == kScans;
+    status.level = status.lost ? ros2::kDiagnosticError : ros2::kDiagnosticOk;
+    status.health = status.lost ? "lost" : "ok";
+    if (!status.lost) status.protection_lateral_m = status.protection_longitudinal_m = 0.25;
+    log.write_estimate(status, Pose2d{1.0 * i + 0.02, 0.49, 0.01 * i}, Eigen::Matrix3d::Identity() * 0.01);
   }
   log.close();
 }

@@ -15,6 +15,8 @@
 //   /truth/body           geometry_msgs/msg/PoseStamped     base_link (the sprung body's frame on its suspension)
 //   /truth/curb_visibility lidarloop_msgs/msg/CurbVisibility map (the curb the traffic hid, per scan)
 //   /localizer/odometry   nav_msgs/msg/Odometry             map -> base_link_estimate (with covariance)
+//   /localizer/status     diagnostic_msgs/msg/DiagnosticArray base_link_estimate (health, lost, protection
+//                                                           bounds; every scan: localizer_status.hpp)
 //   /tf                   tf2_msgs/msg/TFMessage            map -> base_link (truth), map -> base_link_estimate
 //   /tf_static            tf2_msgs/msg/TFMessage            base_link -> lidar (mount), base_link -> gps
 //   /velodyne_packets     velodyne_msgs/msg/VelodyneScan    lidar (with --packets: the scans' raw HDL-32E
@@ -43,6 +45,7 @@ inline constexpr const char* truth_actors = "/truth/actors";
 inline constexpr const char* truth_body = "/truth/body";
 inline constexpr const char* truth_curb_visibility = "/truth/curb_visibility";
 inline constexpr const char* estimate = "/localizer/odometry";
+inline constexpr const char* localizer_status = "/localizer/status";
 inline constexpr const char* tf = "/tf";
 inline constexpr const char* tf_static = "/tf_static";
 inline constexpr const char* velodyne_packets = "/velodyne_packets";

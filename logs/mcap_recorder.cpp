@@ -121,12 +121,18 @@ void McapRecorder::write_curb_visibility(const CurbVisibility& visibility) {
   write(spec, visibility.stamp_ns, ros2::encode_curb_visibility(visibility));
 }
 
-void McapRecorder::write_estimate(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& cov_xy_yaw) {
+void McapRecorder::write_estimate(const LocalizerStatus& status, const std::optional<Pose2d>& pose,
+                                  const Eigen::Matrix3d& cov_xy_yaw) {
   static constexpr ChannelSpec odometry{t::estimate, "nav_msgs/msg/Odometry"};
   static constexpr ChannelSpec tf{t::tf, "tf2_msgs/msg/TFMessage"};
-  write(odometry, stamp_ns,
-        ros2::encode_odometry(ros2::planar_odometry(stamp_ns, pose, cov_xy_yaw, t::map_frame, t::estimate_frame)));
-  write(tf, stamp_ns, ros2::encode_tf({ros2::planar_transform(stamp_ns, t::map_frame, t::estimate_frame, pose)}));
+  static constexpr ChannelSpec diagnostics{t::localizer_status, "diagnostic_msgs/msg/DiagnosticArray"};
+  const int64_t stamp_ns = status.stamp_ns;
+  if (pose) {
+    write(odometry, stamp_ns,
+          ros2::encode_odometry(ros2::planar_odometry(stamp_ns, *pose, cov_xy_yaw, t::map_frame, t::estimate_frame)));
+    write(tf, stamp_ns, ros2::encode_tf({ros2::planar_transform(stamp_ns, t::map_frame, t::estimate_frame, *pose)}));
+  }
+  write(diagnostics, stamp_ns, encode_localizer_status(status));
 }
 
 void McapRecorder::add_attachment(const std::string& name, const std::string& media_type,

@@ -8,6 +8,7 @@
 // produced. The same calls in the same order give the same bytes (see McapWriter).
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -17,6 +18,7 @@
 #include "common/hdl32e_block.hpp"
 #include "common/point_cloud.hpp"
 #include "common/vehicle_messages.hpp"
+#include "logs/localizer_status.hpp"
 #include "logs/mcap/mcap_writer.hpp"
 #include "logs/ros2_messages.hpp"
 
@@ -42,8 +44,11 @@ class McapRecorder {
   // A scan as the HDL-32E's data packets (logs/hdl32e_packets.hpp), stamped with its first packet.
   void write_velodyne_scan(const Hdl32eRotation& rotation);
 
-  // The localizer's estimate: /localizer/odometry (covariance of x, y, yaw) and /tf.
-  void write_estimate(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& cov_xy_yaw);
+  // The localizer's answer to a scan: its status on /localizer/status (localizer_status.hpp), and
+  // once it has a pose (`pose` set) /localizer/odometry (covariance of x, y, yaw) and /tf, all at the
+  // status's stamp.
+  void write_estimate(const LocalizerStatus& status, const std::optional<Pose2d>& pose,
+                      const Eigen::Matrix3d& cov_xy_yaw);
 
   // Logged at the current log time (the newest stamp seen so far), never at wall-clock time.
   void add_attachment(const std::string& name, const std::string& media_type, std::span<const uint8_t> bytes);

@@ -519,6 +519,45 @@ std::vector<ActorState> decode_actor_array(View cdr, const std::string& context,
   return out;
 }
 
+Bytes encode_diagnostic_array(const DiagnosticArray& array) {
+  CdrWriter w;
+  header(w, array.stamp_ns, array.frame_id);
+  w.sequence_length(array.status.size());
+  for (const DiagnosticStatus& s : array.status) {
+    w.u8(s.level);
+    w.string(s.name);
+    w.string(s.message);
+    w.string(s.hardware_id);
+    w.sequence_length(s.values.size());
+    for (const auto& [key, value] : s.values) {
+      w.string(key);
+      w.string(value);
+    }
+  }
+  return std::move(w.buffer());
+}
+
+DiagnosticArray decode_diagnostic_array(View cdr, const std::string& context) {
+  // The least a status and a key-value pair take: their strings' lengths and the sequence counts.
+  constexpr size_t kMinStatusBytes = 1 + 4 * 4, kMinKeyValueBytes = 2 * 4;
+  CdrReader r(cdr, context);
+  DiagnosticArray a;
+  a.stamp_ns = header(r, &a.frame_id);
+  a.status.resize(r.sequence_length(kMinStatusBytes));
+  for (DiagnosticStatus& s : a.status) {
+    s.level = r.u8();
+    s.name = r.string();
+    s.message = r.string();
+    s.hardware_id = r.string();
+    s.values.resize(r.sequence_length(kMinKeyValueBytes));
+    for (auto& [key, value] : s.values) {
+      key = r.string();
+      value = r.string();
+    }
+  }
+  return a;
+}
+
 Bytes encode_velodyne_scan(const VelodyneScan& scan) {
   CdrWriter w;
   w.reserve(scan.packets.size() * (8 + kVelodynePacketSize + 2));

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -135,6 +136,22 @@ struct ActorState {
 };
 Bytes encode_actor_array(int64_t stamp_ns, const std::vector<ActorState>& actors, const std::string& frame_id);
 std::vector<ActorState> decode_actor_array(View cdr, const std::string& context, int64_t* stamp_ns = nullptr);
+
+// diagnostic_msgs/msg/DiagnosticArray: the standard report of a component's health (what rqt_robot_monitor
+// and Foxglove's diagnostics panel show), one DiagnosticStatus per component, each with KeyValue pairs.
+enum DiagnosticLevel : uint8_t { kDiagnosticOk = 0, kDiagnosticWarn = 1, kDiagnosticError = 2, kDiagnosticStale = 3 };
+struct DiagnosticStatus {
+  uint8_t level = kDiagnosticOk;
+  std::string name, message, hardware_id;
+  std::vector<std::pair<std::string, std::string>> values;  // diagnostic_msgs/msg/KeyValue: key, value
+};
+struct DiagnosticArray {
+  int64_t stamp_ns = 0;
+  std::string frame_id;
+  std::vector<DiagnosticStatus> status;
+};
+Bytes encode_diagnostic_array(const DiagnosticArray& array);
+DiagnosticArray decode_diagnostic_array(View cdr, const std::string& context);
 
 // velodyne_msgs/msg/VelodyneScan (ROS 2 velodyne driver): one revolution's raw UDP data packets, each
 // velodyne_msgs/msg/VelodynePacket {builtin_interfaces/Time stamp, uint8[1206] data}.

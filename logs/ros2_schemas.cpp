@@ -154,6 +154,23 @@ const std::map<std::string, std::string>& definitions() {
       {"velodyne_msgs/VelodyneScan",
        "std_msgs/Header header\n"
        "velodyne_msgs/VelodynePacket[] packets\n"},
+      // diagnostic_msgs (ros2/common_interfaces): the localizer's health on /localizer/status.
+      {"diagnostic_msgs/KeyValue",
+       "string key\n"
+       "string value\n"},
+      {"diagnostic_msgs/DiagnosticStatus",
+       "byte OK=0\n"
+       "byte WARN=1\n"
+       "byte ERROR=2\n"
+       "byte STALE=3\n"
+       "byte level\n"
+       "string name\n"
+       "string message\n"
+       "string hardware_id\n"
+       "diagnostic_msgs/KeyValue[] values\n"},
+      {"diagnostic_msgs/DiagnosticArray",
+       "std_msgs/Header header\n"
+       "diagnostic_msgs/DiagnosticStatus[] status\n"},
       {"lidarloop_msgs/ActorArray",
        "# Simulator ground truth of the traffic actors, at each LiDAR scan's stamp.\n"
        "std_msgs/Header header\n"

@@ -7,6 +7,8 @@
 #include <map>
 
 #include "common/input_error.hpp"
+#include "logs/localizer_status.hpp"
+#include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/ros2_messages.hpp"
 #include "logs/tum_file.hpp"
@@ -52,11 +54,33 @@ std::string joined(const std::vector<std::string>& items) {
   return out.empty() ? "none" : out;
 }
 
+// A lidarloop log's /localizer/status says of each of its /localizer/odometry estimates whether the
+// localizer was lost and what it bounded the error by (logs/localizer_status.hpp), matched by stamp.
+// An estimate without a status (an older log) keeps them unknown.
+void apply_statuses(std::vector<EstimateRecord>& estimates, const std::map<int64_t, LocalizerStatus>& statuses) {
+  for (EstimateRecord& e : estimates) {
+    const auto s = statuses.find(e.stamp_ns);
+    if (s == statuses.end()) continue;
+    e.status = s->second.health;
+    e.lost = s->second.lost;
+    e.protection_lateral_m = s->second.protection_lateral_m;
+    e.protection_longitudinal_m = s->second.protection_longitudinal_m;
+  }
+}
+
 EstimateFile read_mcap_file(const std::string& path, const std::string& wanted) {
   McapReader reader(path);
   std::map<std::string, EstimateFile> by_topic;   // every candidate topic, or only the wanted one
   std::map<std::string, std::string> candidates;  // topic -> type, of every candidate channel
+  std::map<int64_t, LocalizerStatus> statuses;    // by stamp
+  size_t status_messages = 0;
   for (McapMessage m; reader.next(m);) {
+    if (m.channel->topic == log_topics::localizer_status) {
+      const std::string where =
+          path + ": message " + std::to_string(++status_messages) + " on " + log_topics::localizer_status;
+      if (auto s = decode_localizer_status(m.data, where)) statuses[s->stamp_ns] = std::move(*s);
+      continue;
+    }
     const std::string type = m.schema ? full_type(m.schema->name) : "";
     if (type != kOdometry && type != kPoseWithCovariance) continue;
     const std::string& topic = m.channel->topic;
@@ -98,6 +122,7 @@ EstimateFile read_mcap_file(const std::string& path, const std::string& wanted) 
   }
   if (!by_topic.count(topic)) throw InputError(path + ": no messages on topic '" + topic + "'");
   EstimateFile out = std::move(by_topic.at(topic));
+  if (topic == log_topics::estimate) apply_statuses(out.estimates, statuses);
   out.format = "MCAP";
   out.topic = topic;
   return out;

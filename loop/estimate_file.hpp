@@ -4,6 +4,8 @@
 //   MCAP  one topic of nav_msgs/msg/Odometry or geometry_msgs/msg/PoseWithCovarianceStamped, CDR, as
 //         a ROS 2 localizer recorded with rosbag2 writes it (header stamps, the (x, y, yaw) block of
 //         the pose covariance).
+// A lidarloop log's own /localizer/odometry comes with its /localizer/status (logs/localizer_status.hpp):
+// each estimate's health, lost state and protection bounds are read from it, matched by stamp.
 // The format is told by the content (the MCAP magic), not the file name. Poses are taken as in the
 // map frame (the truth's); the yaw of a full 3-D quaternion is taken (ros2::yaw_of, the function the
 // log's own readers use). Latency is not known from a file (NaN, written as null).

@@ -2,7 +2,9 @@
 
 namespace lidarloop {
 
-LocalizerBackend::LocalizerBackend(HdMap& map, const LocalizerParams& params) : label_(method_label(params)) {
+LocalizerBackend::LocalizerBackend(HdMap& map, const LocalizerParams& params, const Scenario& scenario)
+    : label_(method_label(params)), kidnaps_(scenario) {
+  check_kidnaps_supported(scenario, params);  // before an external program is started
   if (params.external.command.empty())
     builtin_ = std::make_unique<Localizer>(map, params);
   else
@@ -24,7 +26,9 @@ void LocalizerBackend::on_gps(const GpsFix& fix) {
 }
 
 LocalizerEstimate LocalizerBackend::on_scan(const PointCloud& cloud) {
-  return builtin_ ? builtin_->on_scan(cloud) : external_->on_scan(cloud);
+  if (!builtin_) return external_->on_scan(cloud);
+  for (const Pose2d& offset : kidnaps_.due(cloud.stamp_ns)) builtin_->displace(offset);
+  return builtin_->on_scan(cloud);
 }
 
 const ScanFeatures& LocalizerBackend::last_features() const {

@@ -6,13 +6,16 @@
 
 #include "localizer/localizer.hpp"
 #include "loop/external_localizer.hpp"
+#include "loop/kidnap_schedule.hpp"
 
 namespace lidarloop {
 
 class LocalizerBackend {
  public:
   // `map` must outlive it. An external program is started here (InputError if it cannot be).
-  LocalizerBackend(HdMap& map, const LocalizerParams& params);
+  // `scenario`: the run's; its kidnaps are done to the localizer before the scans they fall due at
+  // (loop/kidnap_schedule.hpp), which needs a built-in method (InputError naming it otherwise).
+  LocalizerBackend(HdMap& map, const LocalizerParams& params, const Scenario& scenario);
 
   void on_can(const CanFrame& frame);
   void on_gps(const GpsFix& fix);
@@ -28,6 +31,7 @@ class LocalizerBackend {
   std::string label_;
   std::unique_ptr<Localizer> builtin_;
   std::unique_ptr<ExternalLocalizer> external_;
+  KidnapSchedule kidnaps_;
   ScanFeatures no_features_;
 };
 

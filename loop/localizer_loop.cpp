@@ -28,9 +28,10 @@ using Message = std::variant<TruthSample, CanFrame, GpsFix, ScanMessage>;
 // The localizers and what they produced. One thread at a time calls process(); nothing else is shared.
 class Localizers {
  public:
-  Localizers(HdMap& map, const std::vector<LocalizerParams>& methods, LoopResult& result) : result_(result) {
+  Localizers(HdMap& map, const std::vector<LocalizerParams>& methods, const Scenario& scenario, LoopResult& result)
+      : result_(result) {
     for (const auto& p : methods) {
-      localizers_.push_back(std::make_unique<LocalizerBackend>(map, p));
+      localizers_.push_back(std::make_unique<LocalizerBackend>(map, p, scenario));
       result_.methods.push_back({localizers_.back()->label(), {}, {}});
     }
   }
@@ -308,7 +309,7 @@ LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<Loc
                               const std::function<void(const LocalizerEstimate&)>& on_estimate) {
   LoopResult result;
   if (methods.empty()) return result;
-  Localizers localizers(map, methods, result);
+  Localizers localizers(map, methods, sim.scenario(), result);
   std::optional<DelayedPose> controller_pose;
   if (closed_loop) controller_pose.emplace(methods.front());
   const auto handed_out = [&](const LocalizerEstimate& e) {

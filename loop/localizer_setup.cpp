@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "common/input_error.hpp"
+#include "loop/kidnap_schedule.hpp"
 #include "loop/map_cache.hpp"
 #include "loop/mapping_drive.hpp"
 
@@ -58,6 +59,7 @@ LocalizerParams localizer_params_for(const Scenario& s, const std::optional<std:
       throw InputError(std::string("--method: ") + e.what());
     }
   }
+  check_kidnaps_supported(s, p);
   return p;
 }
 

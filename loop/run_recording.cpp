@@ -44,6 +44,29 @@ void RecordingSink::on_actors(int64_t stamp_ns, const std::vector<ActorSample>& 
   log_.write_actors(stamp_ns, states);
 }
 
+LocalizerStatus localizer_status(const LocalizerEstimate& e) {
+  LocalizerStatus s;
+  s.stamp_ns = e.stamp_ns;
+  if (e.health & kNotInitialized)
+    s.level = ros2::kDiagnosticStale;
+  else if (e.lost())
+    s.level = ros2::kDiagnosticError;
+  else
+    s.level = e.ok() ? ros2::kDiagnosticOk : ros2::kDiagnosticWarn;
+  s.health = describe_health(e.health);
+  s.health_flags = e.health;
+  s.lost = e.lost();
+  s.protection_lateral_m = e.protection_lateral_m;
+  s.protection_longitudinal_m = e.protection_longitudinal_m;
+  s.wide_search = e.wide_search;
+  return s;
+}
+
+void record_estimate(McapRecorder& log, const LocalizerEstimate& e) {
+  const bool has_pose = !(e.health & kNotInitialized);
+  log.write_estimate(localizer_status(e), has_pose ? std::optional(e.pose) : std::nullopt, e.covariance);
+}
+
 std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>& path, const Scenario& scenario,
                                                const std::string& method, bool packets) {
   if (packets && !path) throw InputError("--packets: needs --record FILE.mcap");

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "localizer/localizer.hpp"
 #include "logs/mcap_recorder.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulation.hpp"
@@ -88,6 +89,12 @@ class RecordingSink : public StreamSink {
   McapRecorder log_;
   bool packets_ = false;
 };
+
+// What /localizer/status says of an estimate (logs/localizer_status.hpp): not initialised is stale,
+// lost an error whatever else is wrong, any other health flag a warning.
+LocalizerStatus localizer_status(const LocalizerEstimate& estimate);
+// An estimate into the log: its status always, its pose once the localizer has one.
+void record_estimate(McapRecorder& log, const LocalizerEstimate& estimate);
 
 // Null when `path` is empty. `method` is the localizer's, empty for `simulate`. `packets`: record
 // the HDL-32E's packets too (InputError without a path).

@@ -217,6 +217,22 @@ TrafficSpec read_actor(const YamlReader& y, const YAML::Node& n) {
   return a;
 }
 
+// A `faults` entry. Kidnaps are the only kind: a GPS jump is the world's doing, a multipath zone of
+// `gps`. `duration_s` bounds at_s: a fault after the end would never happen, which is a mistake.
+KidnapFault read_fault(const YamlReader& y, const YAML::Node& n, double duration_s) {
+  YamlMap m(y, n, "a fault");
+  const YAML::Node kind = m.required("kind");
+  const std::string word = y.string(kind, "kind");
+  if (word != "kidnap")
+    y.fail(kind, "unknown fault kind '" + word + "' (expected kidnap; a GPS jump is a multipath zone of gps)");
+  KidnapFault f;
+  f.at_s = y.number_in(m.required("at_s"), "at_s", 0.0, duration_s);
+  f.offset_m = y.vec2(m.required("offset"), "offset");
+  m.degrees("yaw_deg", f.yaw_rad, -180.0, 180.0);
+  m.done();
+  return f;
+}
+
 Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<Realism> realism) {
   YamlMap root(y, y.root(), "a scenario");
   Scenario s;
@@ -251,6 +267,10 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   if (const YAML::Node t = root["traffic"]) {
     y.expect_sequence(t, "traffic");
     for (const auto& a : t) s.traffic.push_back(read_actor(y, a));
+  }
+  if (const YAML::Node faults = root["faults"]) {
+    y.expect_sequence(faults, "faults");
+    for (const auto& f : faults) s.kidnaps.push_back(read_fault(y, f, s.duration_s));
   }
   // The localizer section is the localizer's to check (read_localizer_params); the method is read
   // here too because the scenario names it in its outputs.

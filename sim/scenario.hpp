@@ -1,7 +1,7 @@
 #pragma once
 // A scenario (scenarios/*.yaml): the world, how long, the seed, the ego's route and speed, sensor
-// overrides, traffic, the localizer to test and the thresholds it must meet. Loading checks syntax,
-// types, ranges and unknown keys (file:line:col); resolving against the world builds the paths and
+// overrides, traffic, faults done to the localizer, the localizer to test and the thresholds it must meet. Loading
+// checks syntax, types, ranges and unknown keys (file:line:col); resolving against the world builds the paths and
 // checks that they stay on the road network.
 #include <optional>
 #include <string>

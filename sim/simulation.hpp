@@ -56,6 +56,7 @@ class Simulation {
 
   int64_t now_ns() const { return now_; }
   int64_t end_ns() const { return scenario_.duration_ns(); }
+  const Scenario& scenario() const { return scenario_; }
   const ResolvedScenario& resolved() const { return resolved_; }
   const VehicleModel& vehicle() const { return vehicle_; }
   const VehicleBody& body() const { return body_; }

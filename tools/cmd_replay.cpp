@@ -11,9 +11,11 @@
 #include <optional>
 
 #include "common/input_error.hpp"
+#include "logs/localizer_status.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/ros2_messages.hpp"
+#include "logs/tum_file.hpp"
 #include "loop/localizer_backend.hpp"
 #include "loop/localizer_setup.hpp"
 #include "loop/map_cache.hpp"
@@ -27,6 +29,27 @@ namespace lidarloop {
 namespace {
 
 namespace topics = log_topics;
+
+// Replay with the recorded method must give the live run's estimates bit for bit; the log's
+// /localizer/status (every scan's health, lost state and protection bounds) says what they were.
+// A note names the first scan whose status differs, or a count that does; nothing to compare in a log
+// without statuses (recorded by `simulate` or an older lidarloop).
+void compare_statuses(const std::string& log, const std::vector<ros2::Bytes>& recorded,
+                      const std::vector<LocalizerEstimate>& estimates) {
+  if (recorded.empty()) return;
+  if (recorded.size() != estimates.size()) {
+    std::cerr << "lidarloop: note: " << log << " has " << recorded.size() << " " << topics::localizer_status
+              << " messages, the replay made " << estimates.size() << " estimates\n";
+    return;
+  }
+  for (size_t i = 0; i < estimates.size(); ++i)
+    if (encode_localizer_status(localizer_status(estimates[i])) != recorded[i]) {
+      std::cerr << "lidarloop: note: the replayed localizer's status at t = " << tum_seconds(estimates[i].stamp_ns)
+                << " s (scan " << i + 1 << ") differs from the one " << log << " recorded\n";
+      return;
+    }
+  std::printf("status     the localizer's status matched the log's at all %zu scans\n", estimates.size());
+}
 
 int run_replay(const Args& args) {
   const std::string log = args.positional().at(0);
@@ -55,7 +78,7 @@ int run_replay(const Args& args) {
   const ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
   HdMap map = open_scenario_map(scenario, world);
 
-  LocalizerBackend localizer(map, params);
+  LocalizerBackend localizer(map, params, scenario);
   std::vector<TruthSample> truth;
   std::vector<LocalizerEstimate> estimates;
   std::optional<GpsFix> pending;  // a fix waits for its heading, recorded right after it
@@ -65,6 +88,7 @@ int run_replay(const Args& args) {
   };
   size_t scans = 0;
   std::vector<CurbVisibility> curb_visibility;
+  std::vector<ros2::Bytes> recorded_statuses;
   for (; more; more = reader.next(message)) {
     const std::string& topic = message.channel->topic;
     const std::string context = log + " " + topic;
@@ -86,6 +110,8 @@ int run_replay(const Args& args) {
       truth.push_back(ros2::decode_truth_state(message.data, context));
     } else if (topic == topics::truth_curb_visibility) {
       curb_visibility.push_back(ros2::decode_curb_visibility(message.data, context));
+    } else if (topic == topics::localizer_status) {
+      recorded_statuses.emplace_back(message.data.begin(), message.data.end());
     } else if (topic == topics::scan) {
       estimates.push_back(localizer.on_scan(ros2::decode_point_cloud(message.data, context)));
       ++scans;
@@ -101,6 +127,7 @@ int run_replay(const Args& args) {
   std::printf("\nlog        %s (%zu scans, seed %llu, recorded with %s)\n", log.c_str(), scans,
               (unsigned long long)scenario.seed, recorded_method.empty() ? "no localizer" : recorded_method.c_str());
   std::printf("curbs      %s\n", curb_occlusion_text(scored.metrics).c_str());
+  if (method == recorded_method) compare_statuses(log, recorded_statuses, estimates);
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
       "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "

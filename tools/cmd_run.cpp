@@ -87,13 +87,10 @@ int run_run(const Args& args) {
   HdMap map = open_scenario_map(s.scenario, s.world);
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   const Progress progress{isatty(STDOUT_FILENO) != 0, "run " + method_label(params), s.scenario.duration_s};
-  std::function<void(const LocalizerEstimate&)> record_estimate;
-  if (recorder)
-    record_estimate = [&](const LocalizerEstimate& e) {
-      if (!(e.health & kNotInitialized)) recorder->log().write_estimate(e.stamp_ns, e.pose, e.covariance);
-    };
-  const LoopResult r = run_localizer_loop(sim, map, {params}, s.scenario.closed_loop, recorder.get(),
-                                          std::ref(progress), record_estimate);
+  std::function<void(const LocalizerEstimate&)> log_estimate;
+  if (recorder) log_estimate = [&](const LocalizerEstimate& e) { record_estimate(recorder->log(), e); };
+  const LoopResult r =
+      run_localizer_loop(sim, map, {params}, s.scenario.closed_loop, recorder.get(), std::ref(progress), log_estimate);
   if (recorder) recorder->log().close();
   progress.clear();
 

@@ -1,5 +1,6 @@
-# Record a run at one thread and at two: the logs must be byte-identical. Replay the log: the estimates
-# and ground truth must be the live run's exactly, and so must every accuracy figure of metrics.json
+# Record a run at one thread and at two: the logs must be byte-identical. Replay the log: the estimates,
+# their statuses (replay compares each with the log's /localizer/status) and ground truth must be the
+# live run's exactly, and so must every accuracy figure of metrics.json
 # (latency is wall time and is not compared), the curb occlusion included (replay reads it from the log).
 # With -DDATA=<source tree>: replay it once more with a copy of the data folder ($LIDARLOOP_DATA) whose
 # assets/vehicle.yaml changed (wheelbase and steering ratio, which the localizer's motion model uses):
@@ -31,6 +32,10 @@ function(replay_as_live dir what)
                   RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT code EQUAL 0 OR err MATCHES "note:")
     message(FATAL_ERROR "${what}: replay exited ${code}\n${out}\n${err}")
+  endif()
+  # Replay compares every scan's /localizer/status (health, lost, protection bounds) with the log's.
+  if(NOT out MATCHES "status     the localizer's status matched the log's at all [0-9]+ scans")
+    message(FATAL_ERROR "${what}: replay did not find the log's localizer statuses matched\n${out}")
   endif()
   foreach(file estimate.tum truth.tum)
     execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORKDIR}/live_1/${file} ${dir}/${file}

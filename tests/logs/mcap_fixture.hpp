@@ -16,6 +16,7 @@ struct SyntheticEstimate {
   int64_t stamp_ns = 0;
   Pose2d pose;
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  LocalizerStatus status;  // at stamp_ns
 };
 
 struct SyntheticRun {
@@ -90,6 +91,18 @@ inline SyntheticRun make_synthetic_run(double seconds, int points, uint64_t seed
       e.stamp_ns = t - 10 * step;
       e.pose = {s.pose.x + 0.1 * u(rng), s.pose.y + 0.1 * u(rng), s.pose.yaw + 0.01 * u(rng)};
       e.cov << 0.04, 0.01, 0.001, 0.01, 0.09, 0.002, 0.001, 0.002, 0.0004;
+      // Every third estimate lost (unbounded, searching wide), the others degraded or not.
+      LocalizerStatus& st = e.status;
+      st.stamp_ns = e.stamp_ns;
+      st.lost = run.estimates.size() % 3 == 2;
+      st.wide_search = st.lost;
+      st.health_flags = st.lost ? 1u << 14 : uint32_t(rng() % 2);
+      st.level = st.lost ? ros2::kDiagnosticError : st.health_flags ? ros2::kDiagnosticWarn : ros2::kDiagnosticOk;
+      st.health = st.lost ? "lost" : st.health_flags ? "no GPS" : "ok";
+      if (!st.lost) {
+        st.protection_lateral_m = 0.3 + 0.1 * u(rng);
+        st.protection_longitudinal_m = 0.5 + 0.1 * u(rng);
+      }
       run.estimates.push_back(e);
     }
   }
@@ -115,7 +128,7 @@ inline McapWriterStats record_synthetic_run(const SyntheticRun& run, const std::
       rec.write_scan(run.scans[scan]);
       rec.write_actors(run.actors[scan].first, run.actors[scan].second);
       const auto& e = run.estimates[scan++];
-      rec.write_estimate(e.stamp_ns, e.pose, e.cov);
+      rec.write_estimate(e.status, e.pose, e.cov);
     }
   }
   rec.close();

@@ -9,11 +9,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 
 #include "common/crc32.hpp"
 #include "common/input_error.hpp"
 #include "logs/cdr.hpp"
+#include "logs/localizer_status.hpp"
 #include "logs/log_export.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
@@ -189,6 +191,71 @@ TEST(Ros2Messages, CurbVisibilityRoundTripsExactly) {
   EXPECT_THROW(ros2::decode_curb_visibility(ros2::View(bytes.data(), bytes.size() - 1), "test"), InputError);
 }
 
+// /localizer/status as a DiagnosticArray: the values as text that reads back to the same bits, the
+// wire layout of diagnostic_msgs, and a malformed value an InputError naming the message.
+TEST(LocalizerStatus, RoundTripsExactlyAsADiagnosticArray) {
+  LocalizerStatus s;
+  s.stamp_ns = 8'100'000'000;
+  s.level = ros2::kDiagnosticWarn;
+  s.health = "no GPS, few curbs";
+  s.health_flags = 0x41;
+  s.protection_lateral_m = 0.1 + 0.2;  // 0.30000000000000004: needs all 17 digits
+  s.protection_longitudinal_m = 1.0 / 3;
+  const ros2::Bytes bytes = encode_localizer_status(s);
+  const ros2::DiagnosticArray array = ros2::decode_diagnostic_array(bytes, "test");
+  EXPECT_EQ(array.frame_id, topics::estimate_frame);
+  ASSERT_EQ(array.status.size(), 1u);
+  const ros2::DiagnosticStatus& d = array.status[0];
+  EXPECT_EQ(d.level, 1);
+  EXPECT_EQ(d.name, "lidarloop localizer");
+  EXPECT_EQ(d.hardware_id, "lidarloop");
+  EXPECT_EQ(d.message, "no GPS, few curbs");
+  using KeyValues = std::vector<std::pair<std::string, std::string>>;
+  EXPECT_EQ(d.values, (KeyValues{{"health_flags", "0x41"},
+                                 {"lost", "false"},
+                                 {"protection_lateral_m", "0.30000000000000004"},
+                                 {"protection_longitudinal_m", "0.3333333333333333"},
+                                 {"wide_search", "false"}}));
+  const std::optional<LocalizerStatus> back = decode_localizer_status(bytes, "test");
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->stamp_ns, s.stamp_ns);
+  EXPECT_EQ(back->health_flags, 0x41u);
+  EXPECT_EQ(back->protection_lateral_m, s.protection_lateral_m);
+  EXPECT_EQ(back->protection_longitudinal_m, s.protection_longitudinal_m);
+
+  LocalizerStatus lost;
+  lost.level = ros2::kDiagnosticError;
+  lost.lost = lost.wide_search = true;
+  const ros2::Bytes lost_bytes = encode_localizer_status(lost);
+  EXPECT_EQ(ros2::decode_diagnostic_array(lost_bytes, "test").status[0].values[2].second, "inf");
+  const std::optional<LocalizerStatus> lost_back = decode_localizer_status(lost_bytes, "test");
+  ASSERT_TRUE(lost_back.has_value());
+  EXPECT_TRUE(lost_back->lost && lost_back->wide_search && std::isinf(lost_back->protection_longitudinal_m));
+
+  // Another component's diagnostics are not the localizer's status; a malformed value is an error.
+  ros2::DiagnosticArray other = array;
+  other.status[0].name = "lidar driver";
+  EXPECT_FALSE(decode_localizer_status(ros2::encode_diagnostic_array(other), "test").has_value());
+  const std::vector<std::pair<size_t, std::string>> bad = {{0, "41"},   {0, "0x"},  {0, "4"}, {1, "yes"},
+                                                           {2, "-0.5"}, {3, "1 m"}, {4, ""}};
+  for (const auto& [index, value] : bad) {
+    ros2::DiagnosticArray edited = array;
+    edited.status[0].values[index].second = value;
+    EXPECT_THROW(decode_localizer_status(ros2::encode_diagnostic_array(edited), "test"), InputError) << value;
+  }
+  ros2::DiagnosticArray missing = array;
+  missing.status[0].values.pop_back();
+  try {
+    decode_localizer_status(ros2::encode_diagnostic_array(missing), "log.mcap");
+    ADD_FAILURE() << "a status without wide_search was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("log.mcap: the localizer status has no value 'wide_search'"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(decode_localizer_status(ros2::View(bytes.data(), bytes.size() - 3), "test"), InputError);
+}
+
 TEST(Ros2Messages, PointCloudRoundTripsExactlyAndRejectsBadLayouts) {
   const auto run = test::make_synthetic_run(0.1, 300, 3);
   const PointCloud& cloud = run.scans.at(0);
@@ -219,6 +286,7 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
   std::vector<ros2::GnssHeading> gps_heading, rtk_heading;
   std::vector<PointCloud> scans;
   std::vector<ros2::Odometry> estimates, truth_odometry;
+  std::vector<std::optional<LocalizerStatus>> statuses;
   std::vector<std::vector<ros2::ActorState>> actors;
   std::vector<ros2::Transform> tf_static, bodies;
   size_t tf = 0;
@@ -249,6 +317,8 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
       estimates.push_back(ros2::decode_odometry(m.data, t));
     else if (t == topics::truth_odometry)
       truth_odometry.push_back(ros2::decode_odometry(m.data, t));
+    else if (t == topics::localizer_status)
+      statuses.push_back(decode_localizer_status(m.data, t));
     else if (t == topics::truth_actors)
       actors.push_back(ros2::decode_actor_array(m.data, t));
     else if (t == topics::tf_static)
@@ -318,6 +388,17 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
       for (int c = 0; c < 3; ++c) EXPECT_EQ(o.pose_covariance[size_t(k[r] * 6 + k[c])], e.cov(r, c));
     EXPECT_EQ(o.pose_covariance[2 * 6 + 2], 0.0);
   }
+  ASSERT_EQ(statuses.size(), run.estimates.size());
+  for (size_t i = 0; i < statuses.size(); ++i) {
+    ASSERT_TRUE(statuses[i].has_value()) << i;
+    const LocalizerStatus &got = *statuses[i], &want = run.estimates[i].status;
+    EXPECT_TRUE(got.stamp_ns == want.stamp_ns && got.level == want.level && got.health == want.health &&
+                got.health_flags == want.health_flags && got.lost == want.lost &&
+                got.protection_lateral_m == want.protection_lateral_m &&
+                got.protection_longitudinal_m == want.protection_longitudinal_m && got.wide_search == want.wide_search)
+        << "status " << i;
+  }
+  EXPECT_TRUE(std::isinf(statuses.at(2)->protection_lateral_m));  // lost: unbounded, and read back so
   ASSERT_EQ(truth_odometry.size(), run.truth.size());
   EXPECT_EQ(truth_odometry[3].linear.x(), run.truth[3].speed);
   EXPECT_EQ(truth_odometry[3].angular.z(), run.truth[3].yaw_rate);
@@ -474,6 +555,12 @@ TEST_F(McapLog, RecoverKeepsEveryCompleteChunkOfACutFile) {
       chunk_ends.emplace_back(ci.chunk_start_offset + ci.chunk_length, so_far);
     }
   }
+  // The Data End record ends where the summary starts (the footer's summary_start): a cut at or after
+  // it leaves the whole data section, and recovery rightly calls that complete.
+  constexpr size_t kFooterRecord = 1 + 8 + 8 + 8 + 4, kMagic = 8, kOpcodeAndLength = 1 + 8;
+  uint64_t summary_start = 0;
+  for (int i = 0; i < 8; ++i)
+    summary_start |= uint64_t(file[file.size() - kMagic - kFooterRecord + kOpcodeAndLength + size_t(i)]) << (8 * i);
   std::mt19937_64 rng(20240607);
   const std::string cut_path = temp_path("cut.mcap"), fixed_path = temp_path("fixed.mcap");
   for (int trial = 0; trial < 20; ++trial) {
@@ -490,7 +577,7 @@ TEST_F(McapLog, RecoverKeepsEveryCompleteChunkOfACutFile) {
     ASSERT_EQ(got.size(), expected) << "cut at " << cut << " of " << file.size();
     EXPECT_TRUE(std::equal(got.begin(), got.end(), all.begin())) << "cut at " << cut;
     EXPECT_EQ(report.messages, expected);
-    EXPECT_FALSE(report.complete);
+    EXPECT_EQ(report.complete, cut >= summary_start) << "cut at " << cut;
     EXPECT_TRUE(read_mcap_summary(fixed_path).has_value());
   }
   // An intact file recovers to the same messages.

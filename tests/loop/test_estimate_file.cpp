@@ -4,10 +4,12 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <limits>
 
 #include <gtest/gtest.h>
 
 #include "common/input_error.hpp"
+#include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_writer.hpp"
 #include "logs/ros2_messages.hpp"
 #include "logs/ros2_schemas.hpp"
@@ -87,6 +89,57 @@ TEST(EstimateFile, McapWithPoseWithCovarianceStamped) {
   EXPECT_EQ(file.format, "MCAP");
   EXPECT_EQ(file.topic, "/localization/pose");
   expect_offset_scored(file);
+}
+
+// A lidarloop log's own estimate: each /localizer/odometry with what its /localizer/status says (the
+// health in words, lost, the protection bounds), as the run had them; the status of a scan before the
+// localizer had a pose has no odometry to go with. The level says the worst of the health.
+TEST(EstimateFile, ALidarloopLogsEstimatesCarryTheirStatus) {
+  LocalizerEstimate waiting, ok, degraded, lost;
+  waiting.stamp_ns = 100 * kMs;
+  waiting.health = kNotInitialized | kNoGps;
+  ok.stamp_ns = 200 * kMs;
+  ok.health = 0;
+  ok.pose = offset_pose(ok.stamp_ns);
+  ok.protection_lateral_m = 0.1 + 0.2;
+  ok.protection_longitudinal_m = 0.45;
+  degraded = ok;
+  degraded.stamp_ns = 300 * kMs;
+  degraded.health = kNoGps;
+  lost = ok;
+  lost.stamp_ns = 400 * kMs;
+  lost.health = kLost | kNoGps;
+  lost.wide_search = true;
+  lost.protection_lateral_m = lost.protection_longitudinal_m = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(localizer_status(waiting).level, ros2::kDiagnosticStale);
+  EXPECT_EQ(localizer_status(ok).level, ros2::kDiagnosticOk);
+  EXPECT_EQ(localizer_status(degraded).level, ros2::kDiagnosticWarn);
+  EXPECT_EQ(localizer_status(lost).level, ros2::kDiagnosticError);
+
+  const std::string path = temp("lidarloop_log.mcap");
+  {
+    McapRecorder log(path, Eigen::Isometry3d::Identity());
+    for (const LocalizerEstimate& e : {waiting, ok, degraded, lost}) record_estimate(log, e);
+  }
+  const EstimateFile file = read_estimate_file(path, log_topics::estimate);
+  ASSERT_EQ(file.estimates.size(), 3u);  // no pose before the localizer had one
+  const EstimateRecord &a = file.estimates[0], &b = file.estimates[1], &c = file.estimates[2];
+  EXPECT_EQ(a.stamp_ns, ok.stamp_ns);
+  EXPECT_EQ(a.status, "ok");
+  EXPECT_FALSE(a.lost);
+  EXPECT_EQ(a.protection_lateral_m, ok.protection_lateral_m);  // every bit
+  EXPECT_EQ(a.protection_longitudinal_m, 0.45);
+  EXPECT_EQ(b.status, "no GPS");
+  EXPECT_FALSE(b.lost);
+  EXPECT_EQ(c.status, describe_health(lost.health));
+  EXPECT_TRUE(c.lost);
+  EXPECT_TRUE(std::isinf(c.protection_lateral_m) && std::isinf(c.protection_longitudinal_m));
+
+  // The truth's odometry in the same log is not the localizer's: no status is put on it.
+  const std::string other = temp("other_topic.mcap");
+  write_mcap(other, "nav_msgs/msg/Odometry", "/localization/odometry",
+             [](int64_t t) { return ros2::encode_odometry(odometry_at(t)); });
+  EXPECT_TRUE(std::isnan(read_estimate_file(other).estimates.at(0).protection_lateral_m));
 }
 
 TEST(EstimateFile, McapWithOdometryAndAFullAttitude) {

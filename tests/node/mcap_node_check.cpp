@@ -3,6 +3,7 @@
 //   mcap_node_check compare FILE.mcap OUT.json checks what the Node reader printed against what was
 //                                              written: counts per topic, the first scan's stamp,
 //                                              fields, and first and last points, value for value.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -58,7 +59,8 @@ int compare(const std::string& mcap, const std::string& json_path) {
                                                  {t::rtk_heading, run.rtk.size()},
                                                  {t::scan, run.scans.size()},
                                                  {t::truth_actors, run.actors.size()},
-                                                 {t::estimate, run.estimates.size()}};
+                                                 {t::estimate, run.estimates.size()},
+                                                 {t::localizer_status, run.estimates.size()}};
   expect_equal("counts per topic", node.at("counts").get<std::map<std::string, size_t>>(), written);
 
   // And the C++ reader sees the same file the same way.
@@ -82,6 +84,29 @@ int compare(const std::string& mcap, const std::string& json_path) {
   compare_point("first point", scan.at("first"), first.points.front());
   compare_point("last point", scan.at("last"), first.points.back());
 
+  // The first lost status, as Foxglove's ROS 2 decoder reads the DiagnosticArray.
+  const json& status = node.at("lost_status");
+  const auto lost = std::find_if(run.estimates.begin(), run.estimates.end(),
+                                 [](const test::SyntheticEstimate& e) { return e.status.lost; });
+  if (lost == run.estimates.end() || status.is_null()) {
+    expect_equal("a lost status", status.is_null(), lost == run.estimates.end());
+  } else {
+    expect_equal(
+        "lost status stamp",
+        status.at("stamp").at("sec").get<int64_t>() * 1'000'000'000 + status.at("stamp").at("nanosec").get<int64_t>(),
+        lost->stamp_ns);
+    expect_equal("lost status level", status.at("level").get<int>(), int(lost->status.level));
+    expect_equal("lost status name", status.at("name").get<std::string>(), std::string(kLocalizerStatusName));
+    expect_equal("lost status message", status.at("message").get<std::string>(), lost->status.health);
+    expect_equal("lost status hardware_id", status.at("hardware_id").get<std::string>(), std::string("lidarloop"));
+    expect_equal("lost status values", status.at("values").get<std::map<std::string, std::string>>(),
+                 std::map<std::string, std::string>{{"health_flags", "0x4000"},
+                                                    {"lost", "true"},
+                                                    {"protection_lateral_m", "inf"},
+                                                    {"protection_longitudinal_m", "inf"},
+                                                    {"wide_search", "true"}});
+  }
+
   expect_equal("attachments", node.at("attachments").size(), size_t(1));
   expect_equal("attachment name", node.at("attachments").at(0).at("name").get<std::string>(),
                std::string("scenario.yaml"));
@@ -90,7 +115,8 @@ int compare(const std::string& mcap, const std::string& json_path) {
 
   if (failures == 0)
     std::cout << "the Node.js reader agrees with the writer: " << node.at("counts").size() << " topics, "
-              << run.scans.size() << " scans, first and last points of the first scan\n";
+              << run.scans.size()
+              << " scans, first and last points of the first scan, the first lost localizer status\n";
   return failures == 0 ? 0 : 1;
 }
 

@@ -3,7 +3,7 @@
 // indexes (McapIndexedReader: footer, summary CRC, chunk and message indexes, chunk CRCs) and once
 // record by record (McapStreamReader, chunk CRCs on), and every message is decoded with the ROS 2
 // definition in its schema. Prints, as JSON: the header, message counts per topic, attachments,
-// metadata, and the first scan's stamp, fields and first and last points.
+// metadata, the first scan's stamp, fields and first and last points, and the first lost localizer status.
 // Usage: node read_mcap.mjs FILE.mcap      Exit 1 (with a message on stderr) on any disagreement.
 import { open, readFile } from "node:fs/promises";
 
@@ -91,7 +91,7 @@ await handle.close();
 const stream = new McapStreamReader({ decompressHandlers, validateCrcs: true });
 stream.append(await readFile(path));
 const schemas = new Map(), channels = new Map(), counts = {};
-let header, firstScan, statistics, records = 0, sawFooter = false;
+let header, firstScan, lostStatus, statistics, records = 0, sawFooter = false;
 for (let record; (record = stream.nextRecord()); ) {
   ++records;
   switch (record.type) {
@@ -105,6 +105,18 @@ for (let record; (record = stream.nextRecord()); ) {
       if (!channel) fail(`message on undefined channel ${record.channelId}`);
       const message = decode(schemas.get(channel.schemaId), channel, record.data);
       counts[channel.topic] = (counts[channel.topic] ?? 0) + 1;
+      // The first lost localizer status (diagnostic_msgs/msg/DiagnosticArray), as decoded.
+      if (!lostStatus && channel.topic === "/localizer/status" && message.status[0]?.level === 2) {
+        const s = message.status[0];
+        lostStatus = {
+          stamp: { sec: message.header.stamp.sec, nanosec: message.header.stamp.nanosec },
+          level: s.level,
+          name: s.name,
+          message: s.message,
+          hardware_id: s.hardware_id,
+          values: Object.fromEntries(s.values.map((kv) => [kv.key, kv.value])),
+        };
+      }
       if (!firstScan && channel.topic === "/lidar/points") {
         const n = message.width * message.height;
         firstScan = {
@@ -133,7 +145,16 @@ if (!same(counts, statisticsCounts)) fail(`Statistics disagree with the messages
 
 console.log(
   JSON.stringify(
-    { header, records, chunks: indexed.chunkIndexes.length, counts, attachments, metadata, first_scan: firstScan ?? null },
+    {
+      header,
+      records,
+      chunks: indexed.chunkIndexes.length,
+      counts,
+      attachments,
+      metadata,
+      first_scan: firstScan ?? null,
+      lost_status: lostStatus ?? null,
+    },
     null,
     2,
   ),

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/units.hpp"
 #include "sim/scenario.hpp"
 #include "test_support.hpp"
 
@@ -74,6 +75,20 @@ std::string edit(const std::string& from, const std::string& to) {
   return s.replace(at, from.size(), to);
 }
 
+// Each case, read as "bad.yaml", must fail at its line and column with its message.
+void expect_rejected(const std::vector<Malformed>& cases) {
+  for (const auto& c : cases) {
+    try {
+      parse_scenario(c.yaml, "bad.yaml");
+      ADD_FAILURE() << c.name << ": accepted";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(std::string("bad.yaml:") + c.location + ": ", 0), 0u) << c.name << ": " << msg;
+      EXPECT_NE(msg.find(c.message), std::string::npos) << c.name << ": " << msg;
+    }
+  }
+}
+
 TEST(Scenario, MalformedScenariosAreRejectedWithTheirOwnMessage) {
   const std::vector<Malformed> cases = {
       {"syntax", edit("seed: 3", "seed: [3"), "4:4", "YAML syntax error"},
@@ -106,16 +121,7 @@ TEST(Scenario, MalformedScenariosAreRejectedWithTheirOwnMessage) {
       {"unknown realism", edit("seed: 3\n", "seed: 3\nrealism: gritty\n"), "4:10",
        "realism must be ideal, typical or harsh, got 'gritty'"},
   };
-  for (const auto& c : cases) {
-    try {
-      parse_scenario(c.yaml, "bad.yaml");
-      ADD_FAILURE() << c.name << ": accepted";
-    } catch (const InputError& e) {
-      const std::string msg = e.what();
-      EXPECT_EQ(msg.rfind(std::string("bad.yaml:") + c.location + ": ", 0), 0u) << c.name << ": " << msg;
-      EXPECT_NE(msg.find(c.message), std::string::npos) << c.name << ": " << msg;
-    }
-  }
+  expect_rejected(cases);
 }
 
 TEST(Scenario, RealismIsTypicalUnlessTheScenarioOrTheCommandSaysOtherwise) {
@@ -133,6 +139,44 @@ TEST(Scenario, RealismOverridesListTheKnobSectionsScalarsInFileOrder) {
                                              "gps.zones[0].centre[1] = 0",     "gps.zones[0].radius = 40",
                                              "gps.zones[0].from_s = 5",        "gps.zones[0].to_s = 25"};
   EXPECT_EQ(realism_overrides(s), expected);  // ego, traffic, localizer and pass are not realism knobs
+}
+
+// `faults`: kidnaps of the localizer, at a time within the run, strictly read like the rest.
+TEST(Scenario, FaultsAreKidnapsWithinTheRun) {
+  const std::string base = "world: campus\nduration_s: 20\nego: {route: {road: loop}}\n";
+  const Scenario s = parse_scenario(base +
+                                        "faults:\n"
+                                        "  - {kind: kidnap, at_s: 12.0, offset: [3.0, -2.0], yaw_deg: 2.0}\n"
+                                        "  - {kind: kidnap, at_s: 5, offset: [0, 1]}\n",
+                                    "faults.yaml");
+  ASSERT_EQ(s.kidnaps.size(), 2u);
+  EXPECT_EQ(s.kidnaps[0].at_s, 12.0);
+  EXPECT_EQ(s.kidnaps[0].offset_m, Eigen::Vector2d(3.0, -2.0));
+  EXPECT_NEAR(s.kidnaps[0].yaw_rad, 2.0 * kDeg, 1e-15);
+  EXPECT_EQ(s.kidnaps[1].at_s, 5.0);
+  EXPECT_EQ(s.kidnaps[1].yaw_rad, 0.0);  // no yaw_deg: a pure shift
+  EXPECT_TRUE(parse_scenario(base, "none.yaml").kidnaps.empty());
+
+  const std::vector<Malformed> cases = {
+      {"not a list", base + "faults: {kind: kidnap}\n", "4:9", "faults must be a list"},
+      {"unknown kind", base + "faults: [{kind: jump, at_s: 1, offset: [1, 0]}]\n", "4:17",
+       "unknown fault kind 'jump' (expected kidnap"},
+      {"no kind", base + "faults: [{at_s: 1, offset: [1, 0]}]\n", "4:10", "missing key 'kind'"},
+      {"after the end", base + "faults: [{kind: kidnap, at_s: 21, offset: [1, 0]}]\n", "4:31",
+       "at_s = 21 is out of range [0, 20]"},
+      {"before the start", base + "faults: [{kind: kidnap, at_s: -1, offset: [1, 0]}]\n", "4:31",
+       "at_s = -1 is out of range"},
+      {"no offset", base + "faults: [{kind: kidnap, at_s: 1}]\n", "4:10", "missing key 'offset'"},
+      {"offset of three", base + "faults: [{kind: kidnap, at_s: 1, offset: [1, 0, 0]}]\n", "4:42",
+       "offset must be [x, y]"},
+      {"offset not finite", base + "faults: [{kind: kidnap, at_s: 1, offset: [.nan, 0]}]\n", "4:43",
+       "offset must be a finite number"},
+      {"yaw out of range", base + "faults: [{kind: kidnap, at_s: 1, offset: [1, 0], yaw_deg: 270}]\n", "4:59",
+       "yaw_deg = 270 is out of range"},
+      {"unknown key", base + "faults: [{kind: kidnap, at_s: 1, offset: [1, 0], heading: 2}]\n", "4:50",
+       "unknown key 'heading'"},
+  };
+  expect_rejected(cases);
 }
 
 class ScenarioOnCampus : public testing::Test {
