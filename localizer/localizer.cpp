@@ -129,6 +129,13 @@ LocalCurbs local_curbs(const CurbLayer& curbs, const Eigen::Vector2d& centre, do
   return {MapIndex(std::move(points)), std::move(tangents)};
 }
 
+// Each axis's sigma of `covariance` in `pose`'s vehicle frame (longitudinal, lateral, yaw).
+Eigen::Vector3d vehicle_sigmas(const Eigen::Matrix3d& covariance, const Pose2d& pose) {
+  const Eigen::Vector2d forward(std::cos(pose.yaw), std::sin(pose.yaw)), left(-forward.y(), forward.x());
+  const Eigen::Matrix2d P = covariance.topLeftCorner<2, 2>();
+  return {std::sqrt(forward.dot(P * forward)), std::sqrt(left.dot(P * left)), std::sqrt(covariance(2, 2))};
+}
+
 }  // namespace
 
 CanMotion can_motion(const CanFrame& f, const VehicleModelParams& vehicle) {
@@ -244,10 +251,12 @@ void Localizer::on_gps(const GpsFix& fix) {
     // One fix is as good as the receiver says; the scale is for the correlation between many. A cold
     // start: lost until the map has pinned the pose down.
     filter_.emplace(Pose2d{p.x(), p.y(), wrap_angle(fix.heading_rad)}, R, params_.filter);
+    last_fix_ = {filter_->pose(), R};
     lost_.start_search();
-    pose_when_lost_ = filter_->pose();
+    trusted_.reset();
     return;
   }
+  last_fix_ = {Pose2d{p.x(), p.y(), filter_->pose().yaw}, R};
   const Eigen::Vector2d innovation = p - xy(filter_->pose());
   const bool stepped = gps_steps_.step(fix.stamp_ns, innovation);
   const double sigma = gps_steps_.noise_sigma_m();
@@ -259,8 +268,13 @@ void Localizer::on_gps(const GpsFix& fix) {
     }
     return;
   }
-  if (lost_.searching()) return;  // the search spans the GPS's doubt, and corrections would move its prior
+  // The search spans the GPS's doubt, and corrections would move its prior (a cold start lets them).
+  if (lost_.searching() && trusted_) return;
   if (lost_.lost()) {
+    if (lost_.searching()) {
+      filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
+      return;
+    }
     // A pose found, being confirmed: the filter itself moves, so steps say nothing new; only the fixes
     // that stepped before (the GPS may be what jumped) wait for the confirmation.
     if (!(gps_stepped_ && stepped))
@@ -270,9 +284,11 @@ void Localizer::on_gps(const GpsFix& fix) {
   // The fix itself beyond the receiver's own error (its variance, not the scaled one), or a step.
   const Eigen::Matrix2d S = filter_->covariance().topLeftCorner<2, 2>() + R.topLeftCorner<2, 2>();
   if (stepped || innovation.dot(S.ldlt().solve(innovation)) > params_.health.gate_gps) {
-    gps_stepped_ = gps_stepped_ || stepped;
-    last_gps_step_ = innovation;
-    disagree(innovation, 0);
+    if (stepped && gps_steps_.level()) {
+      gps_stepped_ = true;
+      last_gps_step_ = innovation - *gps_steps_.level();
+    }
+    disagree(innovation, 0, true);
     return;
   }
   filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
@@ -358,10 +374,15 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
   if (uses_intensity(method))  // 2.2.2
     S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, intensity_calibration_, e);
 
-  if (lost_.searching()) {
-    relocalize(S ? &*S : nullptr, e);
-  } else {
+  // A cold start also lets the narrow matchers (their windows grown to the GPS's doubt) and the GPS
+  // converge the filter as they can, and the search starts afresh whenever they move it: there is no
+  // pose from before to keep the search's prior still for.
+  const bool cold_start = lost_.searching() && !trusted_;
+  if (lost_.searching()) relocalize(S ? &*S : nullptr, e);
+  if (!lost_.searching() || cold_start) {
+    const Pose2d before = filter_->pose();
     match_and_fuse(S ? &*S : nullptr, e);
+    if ((xy(filter_->pose()) - xy(before)).norm() > params_.aps.step_m) relocalizer_.stop();
   }
   if (map_calibration) {
     const StageTimer timer(stage_ms(e, Stage::intensity_matching));
@@ -672,7 +693,11 @@ void Localizer::agree(const Pose2d& prior, bool along, bool across) {
   lost_.agree(along, across, position_sigma());
   if (!lost_.lost()) {
     if (was_lost) {
-      // Found and confirmed: the GPS's level is learnt anew against the pose now trusted.
+      // Found and confirmed. If the GPS had stepped and the filter stayed where it was, the GPS jumped:
+      // it is rejected until it steps back. Its level is learnt anew against the pose now trusted.
+      if (gps_stepped_ && trusted_ && last_gps_step_ &&
+          (xy(filter_->pose()) - xy(trusted_->pose)).norm() < 0.5 * last_gps_step_->norm())
+        gps_fault_level_ = gps_steps_.level();
       gps_steps_.restart();
       gps_stepped_ = false;
     } else {
@@ -682,11 +707,20 @@ void Localizer::agree(const Pose2d& prior, bool along, bool across) {
   }
 }
 
-void Localizer::disagree(const Eigen::Vector2d& innovation, double reach_m) {
+void Localizer::disagree(const Eigen::Vector2d& innovation, double reach_m, bool gps) {
   const bool was_searching = lost_.searching();
-  lost_.disagree({time_ns_, innovation, reach_m});
-  if (lost_.searching() && !was_searching) pose_when_lost_ = filter_->pose();
-  if (lost_.searching()) widen_to(lost_.disagreements(time_ns_));
+  lost_.disagree({time_ns_, innovation, reach_m, gps});
+  if (!lost_.searching() || was_searching) {
+    if (lost_.searching()) widen_to(lost_.disagreements(time_ns_));
+    return;
+  }
+  trusted_ = {filter_->pose(), filter_->covariance()};
+  // Only the GPS disagrees and the map's matches still agree: first see whether they go on agreeing
+  // with the filter as it is (the GPS jumped) before searching anywhere else.
+  if (lost_.only_gps_disagrees(time_ns_))
+    lost_.found();
+  else
+    widen_to(lost_.disagreements(time_ns_));
 }
 
 void Localizer::widen_to(const std::deque<Disagreement>& refused) {
@@ -721,16 +755,20 @@ void Localizer::relocalize(IntensityGrid* S, LocalizerEstimate& e) {
 void Localizer::start_relocalization() {
   const RelocalizationParams& r = params_.relocalization;
   const Pose2d prior = filter_->pose();
-  const Eigen::Matrix3d P = filter_->covariance();
-  const Eigen::Vector2d forward(std::cos(prior.yaw), std::sin(prior.yaw)), left(-forward.y(), forward.x());
-  const Eigen::Vector3d sigmas(std::sqrt(forward.dot(P.topLeftCorner<2, 2>() * forward)),
-                               std::sqrt(left.dot(P.topLeftCorner<2, 2>() * left)), std::sqrt(P(2, 2)));
+  const Eigen::Vector3d sigmas = vehicle_sigmas(filter_->covariance(), prior);
   auto half = [&](double sigma, double max_range) {
     return std::clamp(r.window_sigmas * sigma, std::min(r.min_range_m, max_range), max_range);
   };
   const Eigen::Vector3d ranges(half(sigmas.x(), r.max_longitudinal_m), half(sigmas.y(), r.max_lateral_m),
                                std::min(r.window_sigmas * sigmas.z(), r.max_yaw_deg / kDegPerRad));
-  relocalizer_.start(ranges, ranges / r.window_sigmas);
+  // The filter before it was lost, and the newest GPS fix; a cold start has only the filter as the
+  // GPS set it up.
+  std::vector<Hypothesis> hypotheses;
+  if (trusted_) hypotheses.push_back({trusted_->pose, vehicle_sigmas(trusted_->covariance, trusted_->pose)});
+  if (last_fix_ && !gps_fault_level_)  // a GPS that has jumped says nothing
+    hypotheses.push_back({last_fix_->pose, vehicle_sigmas(last_fix_->covariance, last_fix_->pose)});
+  if (hypotheses.empty()) hypotheses.push_back({prior, sigmas});
+  relocalizer_.start(ranges, hypotheses);
 }
 
 void Localizer::move_to(const Relocation& found) {
@@ -750,8 +788,8 @@ void Localizer::move_to(const Relocation& found) {
   lost_.found();
   // Who jumped? If the map found the car about where the filter had it, the GPS did: it is rejected
   // until it steps back (its level is learnt anew once the pose is confirmed).
-  if (gps_stepped_ && pose_when_lost_ && last_gps_step_) {
-    const double moved = (xy(found.pose) - xy(*pose_when_lost_)).norm();
+  if (gps_stepped_ && trusted_ && last_gps_step_) {
+    const double moved = (xy(found.pose) - xy(trusted_->pose)).norm();
     if (moved < 0.5 * last_gps_step_->norm()) gps_fault_level_ = gps_steps_.level();
   }
   gps_stepped_ = false;

@@ -181,7 +181,7 @@ class Localizer {
   // The filter admits the doubt that made it lost: its spread grows to cover where the refused
   // observations put the car, so the wide search's window (and a bound) covers it.
   void widen_to(const std::deque<Disagreement>& refused);
-  void disagree(const Eigen::Vector2d& innovation, double reach_m);
+  void disagree(const Eigen::Vector2d& innovation, double reach_m, bool gps = false);
   // A map match the filter took (updated from `prior`), pinning down these axes of the car.
   void agree(const Pose2d& prior, bool along, bool across);
   double position_sigma() const;  // the filter's, largest axis
@@ -218,8 +218,14 @@ class Localizer {
   bool gps_stepped_ = false;  // the GPS's disagreement that made the localizer lost was a step
   // Set while the GPS is rejected (kGpsRejected): the innovation level it had before it jumped.
   std::optional<Eigen::Vector2d> gps_fault_level_;
-  std::optional<Pose2d> pose_when_lost_;
-  std::optional<Eigen::Vector2d> last_gps_step_;  // the innovation of the last fix that stepped
+  // The relocalization's hypotheses: the filter as it was when it became lost (none after a cold start),
+  // and the newest fix (rear axle, the filter's heading; the receiver's own variances).
+  struct PoseBelief {
+    Pose2d pose;
+    Eigen::Matrix3d covariance;
+  };
+  std::optional<PoseBelief> trusted_, last_fix_;
+  std::optional<Eigen::Vector2d> last_gps_step_;  // the last step of the fixes from their level
 };
 
 }  // namespace lidarloop

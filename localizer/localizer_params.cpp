@@ -294,6 +294,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("min_curb_score", p.relocalization.min_curb_score, 0.0, 1.0)
       .number("min_aps_margin", p.relocalization.min_aps_margin, 0.0, 1e9)
       .number("min_prior_gap", p.relocalization.min_prior_gap, 0.0, 1e9)
+      .number("max_prior_term", p.relocalization.max_prior_term, 0.0, 1e9)
       .number("along_road_lateral_m", p.relocalization.along_road_lateral_m, 0.0, 100.0)
       .number("along_road_yaw_deg", p.relocalization.along_road_yaw_deg, 0.0, 90.0)
       .number("min_range_m", p.relocalization.min_range_m, 0.0, 100.0)

@@ -36,6 +36,12 @@ void LostDetector::found() {
   recent_.clear();
 }
 
+bool LostDetector::only_gps_disagrees(int64_t t_ns) {
+  for (const Disagreement& d : disagreements(t_ns))
+    if (!d.gps) return false;
+  return true;
+}
+
 const std::deque<Disagreement>& LostDetector::disagreements(int64_t t_ns) {
   const int64_t window_ns = int64_t(p_.window_s * kNsPerS);
   while (!recent_.empty() && recent_.front().stamp_ns < t_ns - window_ns) recent_.pop_front();

@@ -34,6 +34,7 @@ struct Disagreement {
   int64_t stamp_ns = 0;
   Eigen::Vector2d innovation{0, 0};
   double reach_m = 0;
+  bool gps = false;  // a GPS fix (else one of the map's matches)
 };
 
 class LostDetector {
@@ -52,6 +53,8 @@ class LostDetector {
   bool searching() const { return lost_ && !found_; }
   // The disagreements within the window before t_ns.
   const std::deque<Disagreement>& disagreements(int64_t t_ns);
+  // Whether all of those are the GPS's: the map still agrees with the filter.
+  bool only_gps_disagrees(int64_t t_ns);
 
  private:
   LostParams p_;

@@ -22,7 +22,7 @@ Pose2d lateral_and_heading(const Pose2d& found, const Pose2d& prior) {
   return found.compose(Pose2d{d.x, 0, 0});
 }
 
-void Relocalizer::start(const Eigen::Vector3d& half_ranges, const Eigen::Vector3d& prior_sigmas) {
+void Relocalizer::start(const Eigen::Vector3d& half_ranges, const std::vector<Hypothesis>& hypotheses) {
   WideApsParams aps = p_.aps;
   aps.longitudinal_range_m = half_ranges.x();
   aps.lateral_range_m = half_ranges.y();
@@ -33,7 +33,10 @@ void Relocalizer::start(const Eigen::Vector3d& half_ranges, const Eigen::Vector3
   curbs.yaw_range_rad = half_ranges.z();
   aps_ = WideApsSearch(aps);
   curbs_ = CurbHypothesisSearch(curbs);
-  prior_sigmas_ = prior_sigmas;
+  // No hypothesis is sharper than the search can place a pose: a cell and a yaw step.
+  hypotheses_ = hypotheses;
+  const Eigen::Vector3d floor(p_.aps.aps.step_m, p_.aps.aps.step_m, p_.aps.fine_yaw_step_rad);
+  for (Hypothesis& h : hypotheses_) h.sigmas = h.sigmas.cwiseMax(floor);
   active_ = true;
 }
 
@@ -62,33 +65,53 @@ std::optional<Relocation> Relocalizer::step(IntensityGrid* S, IntensityMap& inte
   return found;
 }
 
+double Relocalizer::prior_term(const Pose2d& pose) const {
+  double term = hypotheses_.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+  for (const Hypothesis& h : hypotheses_) {
+    const Pose2d d = relative(h.centre, pose);
+    term = std::min(term, 0.5 * Eigen::Vector3d(d.x, d.y, d.yaw).cwiseQuotient(h.sigmas).squaredNorm());
+  }
+  return term;
+}
+
 std::optional<Relocation> Relocalizer::verdict(const WideApsResult& r, const Pose2d& prior) const {
-  if (!r.ok || r.peak_on_edge) return std::nullopt;
-  // Eq. 14 with the prior: each place's log probability less half its squared distance from the prior
-  // in the prior's sigmas.
-  auto prior_term = [&](const Pose2d& pose) {
-    const Pose2d d = relative(prior, pose);
-    return 0.5 * Eigen::Vector3d(d.x, d.y, d.yaw).cwiseQuotient(prior_sigmas_).squaredNorm();
-  };
-  const double margin = std::isfinite(r.margin) ? r.margin + prior_term(r.runner_up) - prior_term(r.pose)
-                                                : std::numeric_limits<double>::infinity();
+  if (!r.ok || r.peak_on_edge || r.places.empty()) return std::nullopt;
   // Over the refinement's few cells the spread is cut short: at least a cell and a yaw step.
   Eigen::Matrix3d covariance = r.covariance;
   const Eigen::Vector3d floor(p_.aps.aps.step_m, p_.aps.aps.step_m, p_.aps.fine_yaw_step_rad);
   for (int i = 0; i < 3; ++i) covariance(i, i) = std::max(covariance(i, i), floor(i) * floor(i));
-  if (margin >= p_.min_aps_margin) return Relocation{r.pose, covariance, true};
-  const Pose2d other = relative(r.pose, r.runner_up);
-  if (std::abs(other.y) <= p_.along_road_lateral_m && std::abs(other.yaw) <= p_.along_road_yaw_deg / kDegPerRad) {
-    // Repeating paint along the road: the lateral position and the heading are fixed. So is the
-    // longitudinal one if the other place is, by the prior alone, far less likely than the best.
-    const bool prior_decides = prior_term(r.runner_up) - prior_term(r.pose) >= p_.min_prior_gap;
-    return Relocation{prior_decides ? r.pose : lateral_and_heading(r.pose, prior), covariance, prior_decides};
-  }
-  return std::nullopt;
+  // Each place with the prior (the posterior, in logs); the winner, and the best distinct other.
+  auto posterior = [&](const WideApsResult::Place& place) { return place.log_p - prior_term(place.pose); };
+  const WideApsResult::Place* winner = &r.places.front();
+  for (const auto& place : r.places)
+    if (posterior(place) > posterior(*winner)) winner = &place;
+  const WideApsResult::Place* other = nullptr;
+  for (const auto& place : r.places)
+    if (std::hypot(place.pose.x - winner->pose.x, place.pose.y - winner->pose.y) > p_.aps.distinct_separation_m &&
+        (!other || posterior(place) > posterior(*other)))
+      other = &place;
+  // A place none of the hypotheses allows is not taken, however well the paint fits there (a dashed
+  // centre line alone fits as well either side of it).
+  if (prior_term(winner->pose) > p_.max_prior_term) return std::nullopt;
+  if (!other || posterior(*winner) - posterior(*other) >= p_.min_aps_margin)
+    return Relocation{winner->pose, covariance, true};
+  const Pose2d apart = relative(winner->pose, other->pose);
+  if (std::abs(apart.y) > p_.along_road_lateral_m || std::abs(apart.yaw) > p_.along_road_yaw_deg / kDegPerRad)
+    return std::nullopt;
+  // Repeating paint along the road: the lateral position is fixed. So is the longitudinal one if the
+  // prior alone makes the other place far less likely. APS's heading along a lone line is left alone:
+  // over the refinement's small window its spread says too little of it.
+  if (prior_term(other->pose) - prior_term(winner->pose) >= p_.min_prior_gap)
+    return Relocation{winner->pose, covariance, true};
+  Pose2d across = lateral_and_heading(winner->pose, prior);
+  across.yaw = prior.yaw;
+  return Relocation{across, covariance, false, false};
 }
 
 std::optional<Relocation> Relocalizer::verdict(const CurbHypothesesResult& r, const Pose2d& prior) const {
-  if (!r.ok || r.best.score < p_.min_curb_score || r.ambiguous_lateral || r.ambiguous_yaw) return std::nullopt;
+  if (!r.ok || r.best.score < p_.min_curb_score || r.ambiguous_lateral || r.ambiguous_yaw ||
+      prior_term(r.best.pose) > p_.max_prior_term)
+    return std::nullopt;
   // A place is a cluster of this radius: its spread, as a uniform one's sigma, on each axis.
   const double position = p_.curbs.cluster_radius_m / std::sqrt(3.0), yaw = p_.curbs.cluster_yaw_rad / std::sqrt(3.0);
   const Eigen::Matrix3d covariance =

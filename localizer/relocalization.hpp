@@ -7,8 +7,8 @@
 //
 // What a finished search may claim:
 //   - all of x, y and yaw when its best place beats every other distinct place clearly (APS: by
-//     min_aps_margin in Eq. 14's log probability, the GPS prior's Gaussian included; curbs: no other
-//     place fits as well on any axis);
+//     min_aps_margin in Eq. 14's log probability with the hypotheses' prior; curbs: no other place fits
+//     as well on any axis);
 //   - only the lateral position and the heading when the other places that fit as well lie along the
 //     road from the best (dashed lines repeat every few metres, straight curbs say nothing along it),
 //     unless for APS the prior (the GPS) alone rules the other place out;
@@ -42,29 +42,41 @@ struct RelocalizationParams {
   // APS's best must beat the best distinct other place by this much log probability (Eq. 14 with the
   // prior). Stripes repeating every 3 m measured ~40 (ambiguous), paint across the road 370-1200.
   double min_aps_margin = 100.0;
+  // A place must lie within the 99.9 % region of one of the hypotheses: half chi^2 with 3 dof.
+  double max_prior_term = 0.5 * 16.27;
   // Along the road, the best of repeating paint is taken when the prior alone makes the other place this
   // much less likely (half the squared sigmas: 4.5 is 3 sigma farther out).
   double min_prior_gap = 4.5;
   // The places that fit as well lie along the road when they are within this of the best across it
-  // (m) and in heading (deg): the lateral and the heading are then fixed.
+  // (m) and in heading (deg): the lateral position is then fixed, and the heading too if APS's own
+  // spread in heading is within the same.
   double along_road_lateral_m = 0.4, along_road_yaw_deg = 0.5;
-  WideApsParams aps;      // its ranges are set per search
+  WideApsParams aps;  // its ranges are set per search
   CurbHypothesesParams curbs;
+};
+
+// Where the car may be by what the localizer knew before the search: the filter's pose from before it
+// was lost (the GPS may be what jumped) and the GPS's fix (the filter may be what was kidnapped), each
+// with its sigmas (longitudinal m, lateral m, yaw rad in its own vehicle frame).
+struct Hypothesis {
+  Pose2d centre;
+  Eigen::Vector3d sigmas = Eigen::Vector3d::Ones();
 };
 
 struct Relocation {
   Pose2d pose;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // x, y, psi; local frame
-  bool longitudinal = true;  // false: only the lateral position and the heading are fixed
+  bool longitudinal = true;                                  // false: not the position along the road
+  bool heading = true;  // false: not the heading either (only the lateral position)
 };
 
 class Relocalizer {
  public:
   explicit Relocalizer(const RelocalizationParams& params = {}) : p_(params) {}
 
-  // A new search around the prior over half ranges (longitudinal m, lateral m, yaw rad; vehicle frame),
-  // with the prior's sigmas on those axes for Eq. 14's prior term.
-  void start(const Eigen::Vector3d& half_ranges, const Eigen::Vector3d& prior_sigmas);
+  // A new search around the prior over half ranges (longitudinal m, lateral m, yaw rad; vehicle frame).
+  // The places found are weighed by the likelier of the hypotheses (Eq. 14 times a Gaussian prior).
+  void start(const Eigen::Vector3d& half_ranges, const std::vector<Hypothesis>& hypotheses);
   bool active() const { return active_; }
   void stop() { active_ = false; }
   // One share. `S` (at `prior`, or null), the curb features placed at `prior` (world frame) with the
@@ -79,7 +91,9 @@ class Relocalizer {
   RelocalizationParams p_;
   bool active_ = false;
   bool curbs_turn_ = false;
-  Eigen::Vector3d prior_sigmas_ = Eigen::Vector3d::Ones();
+  std::vector<Hypothesis> hypotheses_;
+  // Minus the log of the likelier hypothesis's Gaussian at `pose` (up to a constant).
+  double prior_term(const Pose2d& pose) const;
   WideApsSearch aps_;
   CurbHypothesisSearch curbs_;
 };

@@ -528,6 +528,10 @@ void summarise(const std::vector<WideApsCandidate>& refined, const Pose2d& prior
   r.margin = runner_up ? (best->log_p_per_cell - runner_up->log_p_per_cell) * best->cells
                        : std::numeric_limits<double>::infinity();
   if (runner_up) r.runner_up = runner_up->correction.compose(prior);
+  r.places.clear();
+  for (const WideApsCandidate& c : refined)
+    if (std::isfinite(c.log_p_per_cell))
+      r.places.push_back({c.correction.compose(prior), c.log_p_per_cell * best->cells});
   const Eigen::Matrix2d Rp = rotation(prior.yaw);
   r.covariance.setZero();
   r.covariance.topLeftCorner<2, 2>() = Rp * best->offset_covariance * Rp.transpose();

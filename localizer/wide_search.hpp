@@ -98,6 +98,13 @@ struct WideApsResult {
   // stretch of road with only its centre line gave below 1, with paint across the road in view 370-1200.
   double margin = 0;
   Pose2d runner_up;  // that candidate's pose (local frame), when margin is finite
+  // Every refined candidate: its pose (local frame) and Eq. 14's log P on the best's count of cells, as
+  // log_p is (so a caller can weigh them with a prior of its own).
+  struct Place {
+    Pose2d pose;
+    double log_p = 0;
+  };
+  std::vector<Place> places;
   // The best lies within a coarse cell of the search range's border: the truth may be outside.
   bool peak_on_edge = false;
   int64_t offsets_evaluated = 0;  // poses (x, y, yaw) scored at both levels
