@@ -798,7 +798,9 @@ void Localizer::move_to(const Relocation& found) {
 void Localizer::report_pose(LocalizerEstimate& e) {
   if (filter_) {
     e.pose = filter_->pose();
-    e.covariance = filter_->covariance();
+    const MountUncertainty& m = params_.mount_uncertainty;
+    const double t = m.translation_sigma_m, yaw = m.yaw_sigma_deg / kDegPerRad;
+    e.covariance = filter_->covariance() + Eigen::Vector3d(t * t, t * t, yaw * yaw).asDiagonal().toDenseMatrix();
     if (gps_fault_level_) e.health |= kGpsRejected;
     if (lost_.lost()) {
       e.health |= kLost;  // the bounds stay infinite

@@ -281,6 +281,10 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("min_noise_sigma_m", p.gps_steps.min_noise_sigma_m, 0.001, 100.0)
       .number("step_gate", p.gps_steps.step_gate, 0.1, 1e6)
       .done();
+  YamlMap(y, top["mount_uncertainty"], "mount_uncertainty")
+      .number("yaw_sigma_deg", p.mount_uncertainty.yaw_sigma_deg, 0.0, 90.0)
+      .number("translation_sigma_m", p.mount_uncertainty.translation_sigma_m, 0.0, 10.0)
+      .done();
   YamlMap(y, top["lost"], "lost")
       .number("window_s", p.lost.window_s, 0.01, 100.0)
       .integer("min_disagreements", p.lost.min_disagreements, 1, 1000)
