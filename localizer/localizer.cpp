@@ -268,15 +268,9 @@ void Localizer::on_gps(const GpsFix& fix) {
     }
     return;
   }
-  // The search spans the GPS's doubt, and corrections would move its prior (a cold start lets them).
-  if (lost_.searching() && trusted_) return;
   if (lost_.lost()) {
-    if (lost_.searching()) {
-      filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
-      return;
-    }
-    // A pose found, being confirmed: the filter itself moves, so steps say nothing new; only the fixes
-    // that stepped before (the GPS may be what jumped) wait for the confirmation.
+    // Lost: the filter itself moves, so steps say nothing new; only the fixes that stepped before (the
+    // GPS may be what jumped) wait for the map's verdict.
     if (!(gps_stepped_ && stepped))
       filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
     return;
@@ -374,16 +368,13 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
   if (uses_intensity(method))  // 2.2.2
     S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, intensity_calibration_, e);
 
-  // A cold start also lets the narrow matchers (their windows grown to the GPS's doubt) and the GPS
-  // converge the filter as they can, and the search starts afresh whenever they move it: there is no
-  // pose from before to keep the search's prior still for.
-  const bool cold_start = lost_.searching() && !trusted_;
+  // While lost the narrow matchers (their windows grown to the filter's doubt) and the GPS still
+  // converge the filter as they can (a search may find nothing for long); the search starts afresh
+  // whenever they move it, since its places are kept relative to the filter.
   if (lost_.searching()) relocalize(S ? &*S : nullptr, e);
-  if (!lost_.searching() || cold_start) {
-    const Pose2d before = filter_->pose();
-    match_and_fuse(S ? &*S : nullptr, e);
-    if ((xy(filter_->pose()) - xy(before)).norm() > params_.aps.step_m) relocalizer_.stop();
-  }
+  const Pose2d before = filter_->pose();
+  match_and_fuse(S ? &*S : nullptr, e);
+  if ((xy(filter_->pose()) - xy(before)).norm() > params_.aps.step_m) relocalizer_.stop();
   if (map_calibration) {
     const StageTimer timer(stage_ms(e, Stage::intensity_matching));
     calibrate_lasers_to_the_map(points, ground);
@@ -611,11 +602,9 @@ std::optional<ApsResult> Localizer::match_intensity(IntensityGrid& S, LocalizerE
     return std::nullopt;
   }
   if (aps.peak_on_edge) {
-    // The truth may lie beyond the window.
+    // The truth may lie beyond the window; or the paint says nothing here (a dashed line's flat
+    // stretch): no disagreement to count.
     e.health |= kIntensityMatchRejected;
-    const ApsParams window = aps_window(S.pose);
-    disagree(Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()),
-             std::hypot(window.longitudinal_range_m, window.lateral_range_m));
     return std::nullopt;
   }
   e.intensity_observation = aps.position;
@@ -648,7 +637,9 @@ void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::fusion));
   const Pose2d prior = filter_->pose();
   const Eigen::Vector2d innovation = aps.position - xy(prior);
-  const Eigen::Matrix2d R = aps.covariance * params_.aps_covariance_scale;
+  // APS's claim, scaled by what its innovations have shown of it so far (innovation_scale.hpp).
+  const Eigen::Matrix2d claimed = aps.covariance * params_.aps_covariance_scale;
+  const Eigen::Matrix2d R = scaled_along_across(claimed, prior.yaw, aps_scale_.scale());
   const Eigen::Matrix2d S = filter_->covariance().topLeftCorner<2, 2>() + R;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
     e.health |= kIntensityMatchRejected;
@@ -681,7 +672,15 @@ void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
     filter_->update_intensity_along(aps.position, R, along ? forward : left);
   else
     e.health |= kIntensityAmbiguous;
-  if (along || across) agree(prior, along, across);
+  if (along || across) {
+    const Eigen::Matrix2d to_vehicle = Eigen::Rotation2Dd(-prior.yaw).toRotationMatrix();
+    const Eigen::Vector2d nu = to_vehicle * innovation;
+    const Eigen::Vector2d prior_variance = (to_vehicle * P * to_vehicle.transpose()).diagonal();
+    const double unused = std::numeric_limits<double>::quiet_NaN();
+    const Eigen::Vector2d claimed_variance = (to_vehicle * claimed * to_vehicle.transpose()).diagonal();
+    aps_scale_.add(nu, prior_variance, {along ? claimed_variance.x() : unused, across ? claimed_variance.y() : unused});
+    agree(prior, along, across);
+  }
 }
 
 double Localizer::position_sigma() const {
@@ -765,7 +764,7 @@ void Localizer::start_relocalization() {
   // GPS set it up.
   std::vector<Hypothesis> hypotheses;
   if (trusted_) hypotheses.push_back({trusted_->pose, vehicle_sigmas(trusted_->covariance, trusted_->pose)});
-  if (last_fix_ && !gps_fault_level_)  // a GPS that has jumped says nothing
+  if (last_fix_ && !gps_fault_level_ && !(input_health(time_ns_) & kNoGps))  // nor a jumped or stale GPS
     hypotheses.push_back({last_fix_->pose, vehicle_sigmas(last_fix_->covariance, last_fix_->pose)});
   if (hypotheses.empty()) hypotheses.push_back({prior, sigmas});
   relocalizer_.start(ranges, hypotheses);

@@ -31,6 +31,7 @@
 #include "localizer/gicp_matcher.hpp"
 #include "localizer/gps_step_detector.hpp"
 #include "localizer/hd_map.hpp"
+#include "localizer/innovation_scale.hpp"
 #include "localizer/intensity_calibration.hpp"
 #include "localizer/localizer_params.hpp"
 #include "localizer/lost_detector.hpp"
@@ -212,6 +213,7 @@ class Localizer {
   IntensityCalibration intensity_calibration_;
   ScanFeatures features_;
 
+  InnovationScale aps_scale_;  // APS's noise as its innovations show it
   LostDetector lost_;
   GpsStepDetector gps_steps_;
   Relocalizer relocalizer_;

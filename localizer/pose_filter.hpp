@@ -42,12 +42,12 @@ class MotionPredictor {
 // 100 Hz or a gap of a second): variances grow linearly with the distance driven and the time passed.
 struct PoseFilterParams {
   double position_per_sqrt_m = 0.05;  // m / sqrt(m): wheel slip, speed scale error, model error
-  double yaw_per_sqrt_m = 0.001;      // rad / sqrt(m): steering offset, Eq. 19's simplifications
-  // m / sqrt(s): what odometry cannot see; also what lets the low-cost GPS's slowly wandering bias through.
-  // These three were set for a consistent filter, measured on the scenario suite (one set for all of it):
-  // with 0.2 m / sqrt(s) and 0.002 rad / sqrt(m) the filter claimed 2-3 times its errors across the road
-  // and in heading (mean NEES 0.1 there).
-  double position_per_sqrt_s = 0.05;
+  // rad / sqrt(m): steering offset, Eq. 19's simplifications. Set for a consistent heading over the scenario
+  // suite (one value for all of it): 0.002 claimed twice the heading error there.
+  double yaw_per_sqrt_m = 0.001;
+  // m / sqrt(s): what odometry cannot see; also what lets the low-cost GPS's slowly wandering bias through,
+  // so that with GPS alone the estimate follows the GPS within seconds rather than lagging it.
+  double position_per_sqrt_s = 0.2;
 };
 
 class PoseFilter {
