@@ -678,7 +678,10 @@ void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
     const Eigen::Vector2d prior_variance = (to_vehicle * P * to_vehicle.transpose()).diagonal();
     const double unused = std::numeric_limits<double>::quiet_NaN();
     const Eigen::Vector2d claimed_variance = (to_vehicle * claimed * to_vehicle.transpose()).diagonal();
-    aps_scale_.add(nu, prior_variance, {along ? claimed_variance.x() : unused, across ? claimed_variance.y() : unused});
+    // Learnt while tracking only: lost, the filter's own variance is not yet to be believed.
+    if (!lost_.lost())
+      aps_scale_.add(nu, prior_variance,
+                     {along ? claimed_variance.x() : unused, across ? claimed_variance.y() : unused});
     agree(prior, along, across);
   }
 }
@@ -714,6 +717,8 @@ void Localizer::disagree(const Eigen::Vector2d& innovation, double reach_m, bool
     return;
   }
   trusted_ = {filter_->pose(), filter_->covariance()};
+  lost_by_gps_ = false;
+  for (const Disagreement& d : lost_.disagreements(time_ns_)) lost_by_gps_ = lost_by_gps_ || d.gps;
   // Only the GPS disagrees and the map's matches still agree: first see whether they go on agreeing
   // with the filter as it is (the GPS jumped) before searching anywhere else.
   if (lost_.only_gps_disagrees(time_ns_))
@@ -728,6 +733,10 @@ void Localizer::widen_to(const std::deque<Disagreement>& refused) {
     reach = std::max(reach, d.innovation.allFinite() ? d.innovation.norm() : d.reach_m);
   const RelocalizationParams& r = params_.relocalization;
   const double sigma = reach / r.lost_offset_sigmas, yaw_sigma = r.lost_yaw_sigma_deg / kDegPerRad;
+  search_sigmas_ = search_sigmas_.cwiseMax(Eigen::Vector3d(sigma, sigma, yaw_sigma));
+  if (trusted_) return;
+  // A cold start: the filter's spread is the GPS's guess, and grows with what refutes it, which widens
+  // the narrow matchers' windows as well.
   const Eigen::Matrix3d& P = filter_->covariance();
   filter_->inflate(Eigen::Vector3d(std::max(0.0, sigma * sigma - P(0, 0)), std::max(0.0, sigma * sigma - P(1, 1)),
                                    std::max(0.0, yaw_sigma * yaw_sigma - P(2, 2)))
@@ -735,8 +744,7 @@ void Localizer::widen_to(const std::deque<Disagreement>& refused) {
 }
 
 // While lost: a share of the wide searches (relocalization.hpp) over the window the filter's spread
-// spans; the filter moves to what they find. The narrow matchers wait: their corrections would move the
-// prior under the search's feet.
+// spans; the filter moves to what they find.
 void Localizer::relocalize(IntensityGrid* S, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::intensity_matching));
   e.wide_search = true;
@@ -754,7 +762,7 @@ void Localizer::relocalize(IntensityGrid* S, LocalizerEstimate& e) {
 void Localizer::start_relocalization() {
   const RelocalizationParams& r = params_.relocalization;
   const Pose2d prior = filter_->pose();
-  const Eigen::Vector3d sigmas = vehicle_sigmas(filter_->covariance(), prior);
+  const Eigen::Vector3d sigmas = vehicle_sigmas(filter_->covariance(), prior).cwiseMax(search_sigmas_);
   auto half = [&](double sigma, double max_range) {
     return std::clamp(r.window_sigmas * sigma, std::min(r.min_range_m, max_range), max_range);
   };
@@ -764,7 +772,10 @@ void Localizer::start_relocalization() {
   // GPS set it up.
   std::vector<Hypothesis> hypotheses;
   if (trusted_) hypotheses.push_back({trusted_->pose, vehicle_sigmas(trusted_->covariance, trusted_->pose)});
-  if (last_fix_ && !gps_fault_level_ && !(input_health(time_ns_) & kNoGps))  // nor a jumped or stale GPS
+  // The GPS is a hypothesis of its own after a cold start or when it disagreed too; not when it has
+  // jumped or gone stale, nor when only the map disagreed (the GPS then agrees with the filter, and its
+  // metres of doubt would only let the map's ambiguities in).
+  if (last_fix_ && (!trusted_ || lost_by_gps_) && !gps_fault_level_ && !(input_health(time_ns_) & kNoGps))
     hypotheses.push_back({last_fix_->pose, vehicle_sigmas(last_fix_->covariance, last_fix_->pose)});
   if (hypotheses.empty()) hypotheses.push_back({prior, sigmas});
   relocalizer_.start(ranges, hypotheses);
@@ -772,6 +783,7 @@ void Localizer::start_relocalization() {
 
 void Localizer::move_to(const Relocation& found) {
   relocalizer_.stop();
+  search_sigmas_.setZero();
   Eigen::Matrix3d covariance = found.covariance;
   if (!found.longitudinal) {
     // The filter's doubt along the road stays; across it and in heading, the search's.

@@ -179,8 +179,8 @@ class Localizer {
   void relocalize(IntensityGrid* S, LocalizerEstimate& e);
   void start_relocalization();
   void move_to(const Relocation& found);
-  // The filter admits the doubt that made it lost: its spread grows to cover where the refused
-  // observations put the car, so the wide search's window (and a bound) covers it.
+  // The search admits the doubt that made the filter lost: its window grows to cover where the refused
+  // observations put the car (the filter's own spread is left as it was).
   void widen_to(const std::deque<Disagreement>& refused);
   void disagree(const Eigen::Vector2d& innovation, double reach_m, bool gps = false);
   // A map match the filter took (updated from `prior`), pinning down these axes of the car.
@@ -217,6 +217,7 @@ class Localizer {
   LostDetector lost_;
   GpsStepDetector gps_steps_;
   Relocalizer relocalizer_;
+  Eigen::Vector3d search_sigmas_ = Eigen::Vector3d::Zero();  // longitudinal, lateral (m), yaw (rad)
   bool gps_stepped_ = false;  // the GPS's disagreement that made the localizer lost was a step
   // Set while the GPS is rejected (kGpsRejected): the innovation level it had before it jumped.
   std::optional<Eigen::Vector2d> gps_fault_level_;
@@ -227,6 +228,7 @@ class Localizer {
     Eigen::Matrix3d covariance;
   };
   std::optional<PoseBelief> trusted_, last_fix_;
+  bool lost_by_gps_ = false;                      // the GPS was among the disagreements that made the filter lost
   std::optional<Eigen::Vector2d> last_gps_step_;  // the last step of the fixes from their level
 };
 

@@ -299,6 +299,8 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("min_aps_margin", p.relocalization.min_aps_margin, 0.0, 1e9)
       .number("min_prior_gap", p.relocalization.min_prior_gap, 0.0, 1e9)
       .number("max_prior_term", p.relocalization.max_prior_term, 0.0, 1e9)
+      .number("confirm_distance_m", p.relocalization.confirm_distance_m, 0.0, 100.0)
+      .number("confirm_yaw_deg", p.relocalization.confirm_yaw_deg, 0.0, 90.0)
       .number("along_road_lateral_m", p.relocalization.along_road_lateral_m, 0.0, 100.0)
       .number("along_road_yaw_deg", p.relocalization.along_road_yaw_deg, 0.0, 90.0)
       .number("min_range_m", p.relocalization.min_range_m, 0.0, 100.0)

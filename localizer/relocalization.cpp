@@ -32,6 +32,7 @@ void Relocalizer::start(const Eigen::Vector3d& half_ranges, const std::vector<Hy
   curbs.lateral_range_m = half_ranges.y();
   curbs.yaw_range_rad = half_ranges.z();
   aps_ = WideApsSearch(aps);
+  pending_.reset();
   curbs_ = CurbHypothesisSearch(curbs);
   // No hypothesis is sharper than the search can place a pose: a cell and a yaw step.
   hypotheses_ = hypotheses;
@@ -62,6 +63,18 @@ std::optional<Relocation> Relocalizer::step(IntensityGrid* S, IntensityMap& inte
       aps_.restart();
     }
   }
+  return confirmed(found, prior);
+}
+
+std::optional<Relocation> Relocalizer::confirmed(const std::optional<Relocation>& found, const Pose2d& prior) {
+  if (!found || !found->longitudinal) return found;
+  const Pose2d correction = found->pose.compose(prior.inverse());
+  const bool again = pending_ &&
+                     std::hypot(correction.x - pending_->x, correction.y - pending_->y) <= p_.confirm_distance_m &&
+                     std::abs(wrap_angle(correction.yaw - pending_->yaw)) <= p_.confirm_yaw_deg / kDegPerRad;
+  pending_ = correction;
+  if (!again) return std::nullopt;
+  pending_.reset();
   return found;
 }
 

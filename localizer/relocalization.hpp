@@ -13,7 +13,10 @@
 //     road from the best (dashed lines repeat every few metres, straight curbs say nothing along it),
 //     unless for APS the prior (the GPS) alone rules the other place out;
 //     The localizer stays lost then, and searches again from the corrected pose.
-// Anything else is refused, and the search starts again on the next scans.
+// Anything else is refused, and the search starts again on the next scans. A whole place is taken only
+// when two searches in a row find it (as the same correction of the moving prior, within
+// confirm_distance_m and confirm_yaw_deg): a wrong place that one scan's paint favours (worn or
+// repainted lines) seldom wins twice.
 #include <optional>
 #include <vector>
 
@@ -51,6 +54,7 @@ struct RelocalizationParams {
   // (m) and in heading (deg): the lateral position is then fixed, and the heading too if APS's own
   // spread in heading is within the same.
   double along_road_lateral_m = 0.4, along_road_yaw_deg = 0.5;
+  double confirm_distance_m = 0.5, confirm_yaw_deg = 0.5;
   WideApsParams aps;  // its ranges are set per search
   CurbHypothesesParams curbs;
 };
@@ -87,6 +91,9 @@ class Relocalizer {
  private:
   std::optional<Relocation> verdict(const WideApsResult& r, const Pose2d& prior) const;
   std::optional<Relocation> verdict(const CurbHypothesesResult& r, const Pose2d& prior) const;
+  // A whole place found twice in a row passes; the first time it is kept, as a correction of the prior.
+  std::optional<Relocation> confirmed(const std::optional<Relocation>& found, const Pose2d& prior);
+  std::optional<Pose2d> pending_;
 
   RelocalizationParams p_;
   bool active_ = false;
