@@ -282,7 +282,7 @@ void Localizer::on_gps(const GpsFix& fix) {
       gps_stepped_ = true;
       last_gps_step_ = innovation - *gps_steps_.level();
     }
-    disagree(innovation, 0, true);
+    disagree(innovation, true);
     return;
   }
   filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
@@ -534,7 +534,7 @@ bool Localizer::fuse_pose(const PoseObservation& z, int& rejections, LocalizerEs
   const Eigen::Vector3d innovation(z.pose.x - prior.x, z.pose.y - prior.y, wrap_angle(z.pose.yaw - prior.yaw));
   const Eigen::Matrix3d S = filter_->covariance() + z.covariance;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_curb, rejections)) {
-    disagree(innovation.head<2>(), 0);
+    disagree(innovation.head<2>());
     return false;
   }
   filter_->update_curb(Eigen::Vector3d(z.pose.x, z.pose.y, z.pose.yaw), z.covariance);  // KF2
@@ -643,7 +643,7 @@ void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
   const Eigen::Matrix2d S = filter_->covariance().topLeftCorner<2, 2>() + R;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
     e.health |= kIntensityMatchRejected;
-    disagree(innovation, 0);
+    disagree(innovation);
     return;
   }
   // Beyond the paper: an axis along which Eq. 14's distribution is about as wide as the search window
@@ -695,13 +695,10 @@ void Localizer::agree(const Pose2d& prior, bool along, bool across) {
   lost_.agree(along, across, position_sigma());
   if (!lost_.lost()) {
     if (was_lost) {
-      // Found and confirmed. If the GPS had stepped and the filter stayed where it was, the GPS jumped:
-      // it is rejected until it steps back. Its level is learnt anew against the pose now trusted.
-      if (gps_stepped_ && trusted_ && last_gps_step_ &&
-          (xy(filter_->pose()) - xy(trusted_->pose)).norm() < 0.5 * last_gps_step_->norm())
-        gps_fault_level_ = gps_steps_.level();
+      // Found and confirmed: the GPS's level is learnt anew against the pose now trusted.
+      judge_gps_jump(filter_->pose());
       gps_steps_.restart();
-      gps_stepped_ = false;
+      search_sigmas_.setZero();
     } else {
       // The map corrected the filter: every GPS innovation moves by as much, and that is no step.
       gps_steps_.shift(xy(prior) - xy(filter_->pose()));
@@ -709,9 +706,9 @@ void Localizer::agree(const Pose2d& prior, bool along, bool across) {
   }
 }
 
-void Localizer::disagree(const Eigen::Vector2d& innovation, double reach_m, bool gps) {
+void Localizer::disagree(const Eigen::Vector2d& innovation, bool gps) {
   const bool was_searching = lost_.searching();
-  lost_.disagree({time_ns_, innovation, reach_m, gps});
+  lost_.disagree({time_ns_, innovation, gps});
   if (!lost_.searching() || was_searching) {
     if (lost_.searching()) widen_to(lost_.disagreements(time_ns_));
     return;
@@ -729,8 +726,7 @@ void Localizer::disagree(const Eigen::Vector2d& innovation, double reach_m, bool
 
 void Localizer::widen_to(const std::deque<Disagreement>& refused) {
   double reach = 0;
-  for (const Disagreement& d : refused)
-    reach = std::max(reach, d.innovation.allFinite() ? d.innovation.norm() : d.reach_m);
+  for (const Disagreement& d : refused) reach = std::max(reach, d.innovation.norm());
   const RelocalizationParams& r = params_.relocalization;
   const double sigma = reach / r.lost_offset_sigmas, yaw_sigma = r.lost_yaw_sigma_deg / kDegPerRad;
   search_sigmas_ = search_sigmas_.cwiseMax(Eigen::Vector3d(sigma, sigma, yaw_sigma));
@@ -751,9 +747,11 @@ void Localizer::relocalize(IntensityGrid* S, LocalizerEstimate& e) {
   const Pose2d prior = filter_->pose();
   if (!relocalizer_.active()) start_relocalization();
   std::vector<Eigen::Vector2d> curbs_world;
-  if (uses_curbs(params_.method))
+  if (uses_curbs(params_.method) && features_.curbs.size() >= size_t(params_.relocalization.curbs.min_curbs))
     for (const auto& f : features_.curbs) curbs_world.push_back(vehicle_to_world(prior, f));
-  const LocalCurbs local = local_curbs(map_.curbs, xy(prior), params_.map_window_m);
+  // The map's curbs around the car only when there are curbs to search with (match_curbs cuts its own).
+  const LocalCurbs local =
+      curbs_world.empty() ? LocalCurbs{MapIndex({}), {}} : local_curbs(map_.curbs, xy(prior), params_.map_window_m);
   const std::optional<Relocation> found =
       relocalizer_.step(uses_intensity(params_.method) ? S : nullptr, map_.intensity, curbs_world, local.index, prior);
   if (found) move_to(*found);
@@ -791,18 +789,21 @@ void Localizer::move_to(const Relocation& found) {
     R.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(found.pose.yaw).toRotationMatrix();
     const Eigen::Matrix3d old_vehicle = R.transpose() * filter_->covariance() * R;
     const Eigen::Matrix3d new_vehicle = R.transpose() * found.covariance * R;
-    covariance =
-        R * Eigen::Vector3d(old_vehicle(0, 0), new_vehicle(1, 1), new_vehicle(2, 2)).asDiagonal() * R.transpose();
+    const double yaw_variance = (found.heading ? new_vehicle : old_vehicle)(2, 2);
+    covariance = R * Eigen::Vector3d(old_vehicle(0, 0), new_vehicle(1, 1), yaw_variance).asDiagonal() * R.transpose();
   }
   filter_.emplace(found.pose, covariance, params_.filter);
   if (!found.longitudinal) return;  // still lost: the next scan searches again, narrower across
   lost_.found();
-  // Who jumped? If the map found the car about where the filter had it, the GPS did: it is rejected
-  // until it steps back (its level is learnt anew once the pose is confirmed).
-  if (gps_stepped_ && trusted_ && last_gps_step_) {
-    const double moved = (xy(found.pose) - xy(trusted_->pose)).norm();
-    if (moved < 0.5 * last_gps_step_->norm()) gps_fault_level_ = gps_steps_.level();
-  }
+  judge_gps_jump(found.pose);
+}
+
+// Who jumped, once the map has placed the car? If it is about where the filter had it before it was
+// lost while the GPS had stepped, the GPS did: its fixes are rejected until they step back.
+void Localizer::judge_gps_jump(const Pose2d& placed) {
+  if (gps_stepped_ && trusted_ && last_gps_step_ &&
+      (xy(placed) - xy(trusted_->pose)).norm() < 0.5 * last_gps_step_->norm())
+    gps_fault_level_ = gps_steps_.level();
   gps_stepped_ = false;
 }
 

@@ -182,7 +182,8 @@ class Localizer {
   // The search admits the doubt that made the filter lost: its window grows to cover where the refused
   // observations put the car (the filter's own spread is left as it was).
   void widen_to(const std::deque<Disagreement>& refused);
-  void disagree(const Eigen::Vector2d& innovation, double reach_m, bool gps = false);
+  void disagree(const Eigen::Vector2d& innovation, bool gps = false);
+  void judge_gps_jump(const Pose2d& placed);
   // A map match the filter took (updated from `prior`), pinning down these axes of the car.
   void agree(const Pose2d& prior, bool along, bool across);
   double position_sigma() const;  // the filter's, largest axis

@@ -1,8 +1,9 @@
 #pragma once
 // When the localizer is lost, and how it is found again. "Lost" means its pose is not to be trusted:
 // after a cold start until a map match has pinned it down, or when the observations stop agreeing with
-// the filter (the map's matches refused by the innovation gate or peaking on their window's edge, the
-// GPS stepping away from its usual level: gps_step_detector.hpp), several times within a short window.
+// the filter (the map's matches refused by the innovation gate, a GPS fix beyond the receiver's own
+// error or stepping away from its usual level: gps_step_detector.hpp), several times within a short
+// window.
 // While lost the localizer searches wide (relocalization); a pose found is then confirmed by a few map
 // matches that agree with it before `lost` clears.
 //
@@ -28,12 +29,10 @@ struct LostParams {
   double converged_sigma_m = 0.3;
 };
 
-// A disagreement: when, and the offset the refused observation pointed to (local frame, m), or NaN
-// when it only said the truth lies beyond its window (`reach_m` from the pose then).
+// A disagreement: when, and the offset the refused observation pointed to (local frame, m).
 struct Disagreement {
   int64_t stamp_ns = 0;
   Eigen::Vector2d innovation{0, 0};
-  double reach_m = 0;
   bool gps = false;  // a GPS fix (else one of the map's matches)
 };
 

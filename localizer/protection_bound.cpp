@@ -24,8 +24,7 @@ ProtectionBounds protection_bounds(const Eigen::Matrix3d& covariance, const Pose
   const Eigen::Matrix2d P = covariance.topLeftCorner<2, 2>();
   auto bound = [&](const Eigen::Vector2d& u) {
     double widest = 0;
-    for (const Disagreement& d : refused)
-      widest = std::max(widest, d.innovation.allFinite() ? std::abs(u.dot(d.innovation)) : d.reach_m);
+    for (const Disagreement& d : refused) widest = std::max(widest, std::abs(u.dot(d.innovation)));
     return k * std::sqrt(std::max(0.0, u.dot(P * u))) + widest;
   };
   return {bound(left), bound(forward)};

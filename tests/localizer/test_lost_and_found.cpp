@@ -54,9 +54,9 @@ TEST(GpsStepDetector, AFilterCorrectionShiftedIntoTheLevelIsNoStep) {
 
 TEST(LostDetector, RaisedByEnoughDisagreementsInTheWindowClearedByAgreementOnBothAxes) {
   LostDetector d;  // 4 in 0.5 s; 3 agreements per axis
-  for (int k = 0; k < 3; ++k) d.disagree({k * kFixNs, {1, 0}, 0});
+  for (int k = 0; k < 3; ++k) d.disagree({k * kFixNs, {1, 0}});
   EXPECT_FALSE(d.lost());
-  d.disagree({3 * kFixNs, {1, 0}, 0});
+  d.disagree({3 * kFixNs, {1, 0}});
   EXPECT_TRUE(d.lost());
   EXPECT_TRUE(d.searching());
   d.found();
@@ -69,7 +69,7 @@ TEST(LostDetector, RaisedByEnoughDisagreementsInTheWindowClearedByAgreementOnBot
 
 TEST(LostDetector, DisagreementsSpreadOverTimeDoNotRaiseIt) {
   LostDetector d;
-  for (int k = 0; k < 20; ++k) d.disagree({k * 2 * kFixNs * 2, {1, 0}, 0});  // one every 0.4 s
+  for (int k = 0; k < 20; ++k) d.disagree({k * 2 * kFixNs * 2, {1, 0}});  // one every 0.4 s
   EXPECT_FALSE(d.lost());
 }
 
@@ -85,7 +85,7 @@ TEST(ProtectionBound, IsTheNormalQuantileTimesSigmaOnTheCarsAxesPlusARefusedOffs
   EXPECT_NEAR(b.lateral_m, k * 0.2, 1e-9);
   EXPECT_NEAR(b.longitudinal_m, k * 0.1, 1e-9);
   // A refused observation 2 m ahead of the car widens the longitudinal bound by 2 m.
-  b = protection_bounds(P, north, {{0, {0, 2.0}, 0}}, integrity);
+  b = protection_bounds(P, north, {{0, {0, 2.0}}}, integrity);
   EXPECT_NEAR(b.longitudinal_m, k * 0.1 + 2.0, 1e-9);
   EXPECT_NEAR(b.lateral_m, k * 0.2, 1e-9);
 }
