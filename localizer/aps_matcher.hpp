@@ -24,6 +24,14 @@ struct IntensityGridParams {
   // sill, a coach's skirt and wheels. They move with the traffic, and a bright one riding beside the
   // car matches a crosswalk stripe the same way scan after scan (it dragged APS 8 m in bus_occlusion).
   double max_height = 0.15;
+  // Beyond the paper: S holds the ground of this scan and the frames - 1 before it, moved by odometry
+  // as Eq. 4-5 move the curbs, with the same n (intensity_accumulator.hpp).
+  int frames = 5;
+  // ... but only frames since which the car has turned less than this (deg): Eq. 19's kinematic
+  // odometry knows no tyre slip, so in a bend it misplaces the older frames' paint. Measured on
+  // closed_loop_campus's bends (misleading frames / longitudinal RMSE): 0.5 deg 2 / 0.086 m, 1 deg
+  // 15 / 0.120 m, 2 deg 10 / 0.083 m, no limit 37 / 0.147 m, one scan (the paper) 10 / 0.118 m.
+  double max_turn_deg = 0.5;
 };
 
 // Row-major, in the vehicle frame: x forward along the columns, y left along the rows, the vehicle at
@@ -32,6 +40,12 @@ struct IntensityGrid {
   Pose2d pose;  // the local pose the grid was built at (the prior of the match)
   IntensityGridParams params;
   std::vector<IntensityCell> cells;
+  // How many times more cells take part in Eq. 14 than the newest scan's alone would give (>= 1; 1 for
+  // one scan): S of several scans (IntensityGridParams::frames) has more cells over the same stretch of
+  // paint, and Eq. 14's alpha was set for one scan's. Its product grows that many times more confident
+  // without the match being that many times more accurate, so the caller widens APS's covariance by
+  // this (measured on closed_loop_campus: longitudinal NEES 3.1 with one scan, 6.8 with five unwidened).
+  double redundancy = 1.0;
 
   // Throws std::out_of_range outside the grid.
   const IntensityCell& at(int col, int row) const;

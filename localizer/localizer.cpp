@@ -96,21 +96,24 @@ std::vector<Eigen::Vector2d> detect_scan_curbs(const ScanPoints& points, const s
   return curbs;
 }
 
-// 2.2.2: grid S of the road surface's intensities around the vehicle (Eq. 8), placed at `pose`, each
-// laser's reading first put on the map's scale (beyond the paper: intensity_calibration.hpp).
+// 2.2.2: grid S of the road surface's intensities around the vehicle (Eq. 8), placed at `pose`, from
+// this scan's ground and the frames before it (intensity_accumulator.hpp), each laser's reading first
+// put on the map's scale (beyond the paper: intensity_calibration.hpp).
 IntensityGrid intensity_grid(const ScanPoints& points, const std::vector<size_t>& ground, const Pose2d& pose,
-                             const IntensityGridParams& params, const IntensityCalibration& calibration,
+                             const Pose2d& motion, const IntensityGridParams& params, int min_count,
+                             const IntensityCalibration& calibration, IntensityAccumulator& accumulator,
                              LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::intensity_matching));
-  std::vector<Eigen::Vector3d> ground_xyz;
+  std::vector<Eigen::Vector2d> ground_xy;
   std::vector<double> intensities;
-  ground_xyz.reserve(ground.size());
+  ground_xy.reserve(ground.size());
   intensities.reserve(ground.size());
   for (size_t i : ground) {
-    ground_xyz.push_back(points.xyz[i]);
+    ground_xy.push_back(points.xyz[i].head<2>());
     intensities.push_back(calibration.correct(points.ring[i], points.intensity[i]));
   }
-  return build_intensity_grid(ground_xyz, intensities, pose, params);
+  accumulator.add(ground_xy, intensities, motion);
+  return accumulator.grid(pose, params, min_count);
 }
 
 // The map's curbs around `centre` in a small KD-tree of their own: the matchers' thousands of
@@ -181,6 +184,7 @@ Localizer::Localizer(HdMap& map, const LocalizerParams& params)
       rng_(params.seed),
       predictor_(params.vehicle),
       accumulator_(params.curb_features.frames),
+      intensity_accumulator_(params.intensity_grid.frames, params.intensity_grid.max_turn_deg / kDegPerRad),
       intensity_calibration_(params.intensity_calibration),
       lost_(params.lost),
       gps_steps_(params.gps_steps),
@@ -339,7 +343,9 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
   const bool empty = points.size() < size_t(std::max(params_.health.min_scan_points, 1));
   if (empty) e.health |= kEmptyScan;
   if (empty || !filter_) {
-    accumulator_.add({}, motion);  // keep the older frames where they are relative to the car
+    // Keep the older frames where they are relative to the car.
+    accumulator_.add({}, motion);
+    intensity_accumulator_.add({}, {}, motion);
     return;
   }
 
@@ -366,7 +372,8 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
     calibrate_lasers_to_each_other(points, ground);
   }
   if (uses_intensity(method))  // 2.2.2
-    S = intensity_grid(points, ground, filter_->pose(), params_.intensity_grid, intensity_calibration_, e);
+    S = intensity_grid(points, ground, filter_->pose(), motion, params_.intensity_grid, params_.aps.min_count,
+                       intensity_calibration_, intensity_accumulator_, e);
 
   // While lost the narrow matchers (their windows grown to the filter's doubt) and the GPS still
   // converge the filter as they can (a search may find nothing for long); the search starts afresh
@@ -389,7 +396,7 @@ void Localizer::match_and_fuse(IntensityGrid* S, LocalizerEstimate& e) {
   }
   if (S) {
     const std::optional<ApsResult> z = match_intensity(*S, e);  // 3.2
-    if (z) fuse_intensity(*z, e);                               // 3.3
+    if (z) fuse_intensity(*z, S->redundancy, e);                // 3.3
   }
 }
 
@@ -633,12 +640,13 @@ ApsParams Localizer::aps_window(const Pose2d& prior) const {
 
 // 3.3: the APS position into KF2, if it passes the innovation gate; only along the road when the curbs
 // were matched in this scan (see aps_longitudinal_only_with_curbs).
-void Localizer::fuse_intensity(const ApsResult& aps, LocalizerEstimate& e) {
+void Localizer::fuse_intensity(const ApsResult& aps, double redundancy, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::fusion));
   const Pose2d prior = filter_->pose();
   const Eigen::Vector2d innovation = aps.position - xy(prior);
-  // APS's claim, scaled by what its innovations have shown of it so far (innovation_scale.hpp).
-  const Eigen::Matrix2d claimed = aps.covariance * params_.aps_covariance_scale;
+  // APS's claim, widened by S's redundancy (IntensityGrid::redundancy), then scaled by what its
+  // innovations have shown of it so far (innovation_scale.hpp).
+  const Eigen::Matrix2d claimed = aps.covariance * params_.aps_covariance_scale * redundancy;
   const Eigen::Matrix2d R = scaled_along_across(claimed, prior.yaw, aps_scale_.scale());
   const Eigen::Matrix2d S = filter_->covariance().topLeftCorner<2, 2>() + R;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {

@@ -32,6 +32,7 @@
 #include "localizer/gps_step_detector.hpp"
 #include "localizer/hd_map.hpp"
 #include "localizer/innovation_scale.hpp"
+#include "localizer/intensity_accumulator.hpp"
 #include "localizer/intensity_calibration.hpp"
 #include "localizer/localizer_params.hpp"
 #include "localizer/lost_detector.hpp"
@@ -169,7 +170,7 @@ class Localizer {
   std::optional<PoseObservation> match_points(const ScanPoints& points, LocalizerEstimate& e);
   std::optional<ApsResult> match_intensity(IntensityGrid& S, LocalizerEstimate& e);
   ApsParams aps_window(const Pose2d& prior) const;
-  void fuse_intensity(const ApsResult& aps, LocalizerEstimate& e);
+  void fuse_intensity(const ApsResult& aps, double redundancy, LocalizerEstimate& e);
   bool pose_known_to_calibrate() const;
   void calibrate_lasers_to_each_other(const ScanPoints& points, const std::vector<size_t>& ground);
   void calibrate_lasers_to_the_map(const ScanPoints& points, const std::vector<size_t>& ground);
@@ -205,6 +206,7 @@ class Localizer {
   std::optional<int64_t> last_can_ns_, last_gps_ns_;
 
   CurbAccumulator accumulator_;
+  IntensityAccumulator intensity_accumulator_;  // the ground of the last scans, for S
   std::optional<Pose2d> previous_scan_odometry_;
   int curb_rejections_ = 0, intensity_rejections_ = 0, point_rejections_ = 0;
   GicpTarget gicp_target_;
