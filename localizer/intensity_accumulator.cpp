@@ -29,8 +29,7 @@ void IntensityAccumulator::add(const std::vector<Eigen::Vector2d>& ground, const
   while (int(history_.size()) > frames_ || std::abs(history_.back().turn_rad) > max_turn_rad_) history_.pop_back();
 }
 
-IntensityGrid IntensityAccumulator::grid(const Pose2d& pose, const IntensityGridParams& params,
-                                         int min_count) const {
+IntensityGrid IntensityAccumulator::grid(const Pose2d& pose, const IntensityGridParams& params, int min_count) const {
   std::vector<Eigen::Vector3d> all;
   std::vector<double> intensities;
   all.reserve(points());

@@ -170,6 +170,8 @@ std::string metrics_json(const Metrics& m) {
        {{"frames_with_bounds", m.integrity.frames_with_bounds},
         {"misleading_frames", m.integrity.misleading_frames},
         {"misleading_fraction", finite_or_null(m.integrity.misleading_fraction)},
+        {"frames_awaiting_alert", m.integrity.frames_awaiting_alert},
+        {"misleading_awaiting_alert", m.integrity.misleading_awaiting_alert},
         {"availability", finite_or_null(m.integrity.availability)}}},
       {"recovery", recovery_json(m.recovery)},
       {"thresholds",
@@ -219,8 +221,12 @@ std::string integrity_text(const Metrics& m) {
                              format("%.2f", m.thresholds.alert_limit_longitudinal_m) + " m longitudinal";
   if (in.frames_with_bounds == 0)
     return "no protection bounds given; available " + cell(100 * in.availability, "%.1f%%") + " (" + limits + ")";
+  const std::string awaiting = in.frames_awaiting_alert == 0
+                                   ? ""
+                                   : " (and " + std::to_string(in.misleading_awaiting_alert) + " of " +
+                                         std::to_string(in.frames_awaiting_alert) + " awaiting an alert given in time)";
   return "misleading " + std::to_string(in.misleading_frames) + " of " + std::to_string(in.frames_with_bounds) +
-         " frames with bounds (" + cell(100 * in.misleading_fraction, "%.2f%%") + "), available " +
+         " frames with bounds (" + cell(100 * in.misleading_fraction, "%.2f%%") + ")" + awaiting + ", available " +
          cell(100 * in.availability, "%.1f%%") + " (" + limits + ")";
 }
 
@@ -245,7 +251,8 @@ void write_errors_csv(const std::string& path, const ScoredRun& run, const std::
   std::string text =
       "t_s,lateral_m,longitudinal_m,heading_deg,position_m,est_x_m,est_y_m,est_yaw_rad,truth_x_m,truth_y_m,"
       "truth_yaw_rad,status,latency_ms,sigma_x_m,sigma_y_m,sigma_yaw_deg,sigma_lateral_m,sigma_longitudinal_m,"
-      "nees_lateral,nees_longitudinal,nees_heading,protection_lateral_m,protection_longitudinal_m,lost,misleading\n";
+      "nees_lateral,nees_longitudinal,nees_heading,protection_lateral_m,protection_longitudinal_m,lost,misleading,"
+      "awaiting_alert\n";
   for (size_t i = 0; i < run.errors.size(); ++i) {
     const FrameError& e = run.errors[i];
     const EstimateRecord& est = estimates.at(run.estimate_index.at(i));
@@ -260,7 +267,8 @@ void write_errors_csv(const std::string& path, const ScoredRun& run, const std::
             number(nees(e.lateral_m, e.sigma_lateral_m)) + ',' +
             number(nees(e.longitudinal_m, e.sigma_longitudinal_m)) + ',' +
             number(nees(e.heading_rad, e.sigma_heading_rad)) + ',' + number(e.protection_lateral_m) + ',' +
-            number(e.protection_longitudinal_m) + ',' + (e.lost ? '1' : '0') + ',' + (misleading(e) ? '1' : '0') + '\n';
+            number(e.protection_longitudinal_m) + ',' + (e.lost ? '1' : '0') + ',' + (misleading(e) ? '1' : '0') + ',' +
+            (e.awaiting_alert ? '1' : '0') + '\n';
   }
   write_text_file(path, text);
 }

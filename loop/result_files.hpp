@@ -27,7 +27,7 @@ void write_metrics_json(const std::string& path, const Metrics& metrics);
 // by people and plotting scripts), both poses, the estimate's status, latency and standard deviations
 // (map axes), then (loop/scorer.hpp's conventions) the lateral and longitudinal standard deviations in
 // the truth's frame, the NEES per axis (nan without a variance), the protection bounds (nan when not
-// given), lost and misleading (0 or 1).
+// given), lost, misleading and awaiting_alert (0 or 1; loop/scorer.hpp's integrity convention).
 void write_errors_csv(const std::string& path, const ScoredRun& run, const std::vector<EstimateRecord>& estimates);
 
 // TUM trajectory for evo: `t x y z qx qy qz qw`, t in seconds, z = 0, the yaw as a rotation about z

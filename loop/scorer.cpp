@@ -130,8 +130,13 @@ Integrity integrity(const std::vector<FrameError>& frames, double alert_limit_la
   for (const FrameError& f : frames) {
     // An infinite bound (a lost localizer's "anywhere") is a bound; NaN is none given.
     if (!std::isnan(f.protection_lateral_m) && !std::isnan(f.protection_longitudinal_m)) {
-      ++in.frames_with_bounds;
-      in.misleading_frames += misleading(f);
+      if (f.awaiting_alert) {
+        ++in.frames_awaiting_alert;
+        in.misleading_awaiting_alert += misleading(f);
+      } else {
+        ++in.frames_with_bounds;
+        in.misleading_frames += misleading(f);
+      }
     }
     available_frames += available(f, alert_limit_lateral_m, alert_limit_longitudinal_m);
   }
@@ -154,7 +159,7 @@ Consistency consistency(const std::vector<FrameError>& frames) {
     double beyond_fraction() const { return frames ? double(beyond) / double(frames) : kNaN; }
   } lateral, longitudinal, heading, any;
   for (const FrameError& f : frames) {
-    if (f.lost) continue;
+    if (f.lost || f.awaiting_alert) continue;
     const double n_lat = nees(f.lateral_m, f.sigma_lateral_m), n_long = nees(f.longitudinal_m, f.sigma_longitudinal_m),
                  n_yaw = nees(f.heading_rad, f.sigma_heading_rad);
     lateral.add(n_lat);
@@ -201,6 +206,18 @@ std::vector<EventRecovery> event_recovery(const std::vector<FrameError>& frames,
     out.push_back(r);
   }
   return out;
+}
+
+void mark_awaiting_alert(std::vector<FrameError>& frames, const std::vector<EventRecovery>& recovery,
+                         double time_to_alert_s) {
+  for (const EventRecovery& r : recovery) {
+    // The start is no fault: the localizer's first fix is all it has, and it claims no more.
+    if (r.event.what == "start" || !(r.lost_raised_after_s <= time_to_alert_s)) continue;
+    const int64_t from = r.event.stamp_ns;
+    const double until_s = r.lost_raised_after_s;
+    for (FrameError& f : frames)
+      if (f.stamp_ns >= from && seconds_between(from, f.stamp_ns) < until_s) f.awaiting_alert = true;
+  }
 }
 
 Pose2d truth_at(const std::vector<TruthPose>& truth, int64_t t_ns) {
@@ -350,11 +367,12 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
     m.max_heading_deg = std::max(m.max_heading_deg, std::abs(e.heading_rad) * kDegPerRad);
   }
   m.frames = run.errors.size();
-  m.consistency = consistency(run.errors);
-  m.integrity = integrity(run.errors, thresholds.alert_limit_lateral_m, thresholds.alert_limit_longitudinal_m);
   std::sort(in_range.begin(), in_range.end(),
             [](const FrameError& a, const FrameError& b) { return a.stamp_ns < b.stamp_ns; });
   m.recovery = event_recovery(in_range, events, recovery_criteria.position_m);
+  mark_awaiting_alert(run.errors, m.recovery, recovery_criteria.lost_within_s);
+  m.consistency = consistency(run.errors);
+  m.integrity = integrity(run.errors, thresholds.alert_limit_lateral_m, thresholds.alert_limit_longitudinal_m);
   m.lateral_rmse_m = rmse(lateral);
   m.longitudinal_rmse_m = rmse(longitudinal);
   m.heading_rmse_deg = rmse(heading_deg);

@@ -30,7 +30,12 @@
 // without both bounds, NaN, is neither misleading nor counted; an infinite bound is never exceeded).
 // It is available when it is not `lost` and both its bounds are under the scenario's alert limits
 // (PassThresholds). Both count every scored frame, the ones right after a fault included: those are
-// the frames integrity is about.
+// the frames integrity is about, with one exception, integrity's time to alert: a fault (a kidnap, a
+// GPS jump) the localizer cannot see before its next observations disagree, and for which it raised
+// `lost` within the recovery's lost_within_s, leaves the frames from the fault to that alert awaiting
+// it. They are counted apart (misleading_awaiting_alert) and kept out of the misleading fraction and
+// of NEES, which judge the filter on the model it has; a localizer that alerts late or never has all
+// of them counted.
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -94,6 +99,7 @@ struct FrameError {
   double protection_lateral_m = std::numeric_limits<double>::quiet_NaN();
   double protection_longitudinal_m = std::numeric_limits<double>::quiet_NaN();
   bool lost = false;
+  bool awaiting_alert = false;  // after a fault, before the `lost` raised in time for it (above)
 };
 
 // The consistency of a run's covariance (the convention above); NaN where no frame counts.
@@ -115,7 +121,10 @@ struct Integrity {
   size_t frames_with_bounds = 0;  // scored frames giving both protection bounds (infinite ones too)
   size_t misleading_frames = 0;
   double misleading_fraction = std::numeric_limits<double>::quiet_NaN();  // of frames_with_bounds
-  double availability = std::numeric_limits<double>::quiet_NaN();         // of all scored frames
+  // Frames awaiting an alert given in time, with both bounds, and those of them misleading: in none of
+  // the figures above.
+  size_t frames_awaiting_alert = 0, misleading_awaiting_alert = 0;
+  double availability = std::numeric_limits<double>::quiet_NaN();  // of all scored frames
 };
 
 // How the localizer came back from one event, each time in seconds from the event and measured on
@@ -212,6 +221,10 @@ Consistency consistency(const std::vector<FrameError>& frames);
 
 // One EventRecovery per event, in time order, from `frames` (sorted by stamp, each estimate in the
 // truth's range); `position_m` is the error a recovered estimate stays under.
+// Marks the frames awaiting an alert given in time (the integrity convention above): for each fault
+// whose `lost` was raised within time_to_alert_s, those from the fault to the alert.
+void mark_awaiting_alert(std::vector<FrameError>& frames, const std::vector<EventRecovery>& recovery,
+                         double time_to_alert_s);
 std::vector<EventRecovery> event_recovery(const std::vector<FrameError>& frames, std::vector<FaultEvent> events,
                                           double position_m);
 

@@ -189,12 +189,23 @@ TEST(Recovery, AKidnapIsMeasuredFromItsEventAndKeptOutOfTheAccuracy) {
   EXPECT_NEAR(m.recovery[1].lost_raised_after_s, 0.4, 1e-9);
   EXPECT_NEAR(m.recovery[1].lost_cleared_after_s, 2.0, 1e-9);
   // [10 s, 13 s] at 10 Hz: 31 recovery frames, out of the RMSE and maxima but scored, so counted in
-  // integrity: the 4 m frames 10.0 and 10.1-10.3 s (not yet lost) are misleading (bounds 0.2 m).
+  // integrity: the 4 m frames 10.0 and 10.1-10.3 s (not yet lost) would be misleading (bounds 0.2 m),
+  // but `lost` came 0.4 s after the kidnap, within the 1 s time to alert: they await it, apart.
   EXPECT_EQ(m.frames, 201u);
   EXPECT_EQ(m.recovery_frames, 31u);
   EXPECT_DOUBLE_EQ(m.lateral_rmse_m, 0.0);
   EXPECT_DOUBLE_EQ(m.max_position_error_m, 0.0);
-  EXPECT_EQ(m.integrity.misleading_frames, 4u);
+  EXPECT_EQ(m.integrity.misleading_frames, 0u);
+  EXPECT_EQ(m.integrity.frames_awaiting_alert, 4u);
+  EXPECT_EQ(m.integrity.misleading_awaiting_alert, 4u);
+  EXPECT_DOUBLE_EQ(m.consistency.mean_nees_lateral, 0.0);  // every other frame not lost is exact
+  // An alert later than the time to alert leaves them misleading, and in NEES.
+  PassThresholds late = t;
+  late.recovery->lost_within_s = 0.3;
+  const Metrics alerted_late = score(straight_truth(20), kidnapped(), straight_route(), late, "m", "s", events).metrics;
+  EXPECT_EQ(alerted_late.integrity.misleading_frames, 4u);
+  EXPECT_EQ(alerted_late.integrity.frames_awaiting_alert, 0u);
+  EXPECT_GT(alerted_late.consistency.mean_nees_lateral, 1.0);
   EXPECT_TRUE(m.pass) << testing::PrintToString(m.failures);
   // Unset, the same figures are measured, not gated, and every frame is in the accuracy.
   const Metrics ungated = score(straight_truth(20), kidnapped(), straight_route(), {}, "m", "s", events).metrics;
@@ -375,22 +386,25 @@ TEST(IntegrityFiles, ErrorsCsvAppendsTheColumnsAndMetricsJsonHoldsTheFigures) {
             "t_s,lateral_m,longitudinal_m,heading_deg,position_m,est_x_m,est_y_m,est_yaw_rad,truth_x_m,truth_y_m,"
             "truth_yaw_rad,status,latency_ms,sigma_x_m,sigma_y_m,sigma_yaw_deg,sigma_lateral_m,sigma_longitudinal_m,"
             "nees_lateral,nees_longitudinal,nees_heading,protection_lateral_m,protection_longitudinal_m,lost,"
-            "misleading");
+            "misleading,awaiting_alert");
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   ASSERT_EQ(lines.size(), 201u);
-  // 10.1 s: 4 m left, sigma 0.1 m: NEES 1600 lateral; bounds 0.2 m; not yet lost: misleading.
-  EXPECT_NE(lines[101].find(",0.1,0.1,1600,0,0,0.2,0.2,0,1"), std::string::npos) << lines[101];
+  // 10.1 s: 4 m left, sigma 0.1 m: NEES 1600 lateral; bounds 0.2 m; not yet lost: misleading, awaiting
+  // the alert raised at 10.4 s.
+  EXPECT_NE(lines[101].find(",0.1,0.1,1600,0,0,0.2,0.2,0,1,1"), std::string::npos) << lines[101];
   // 10.5 s: lost, so not misleading.
-  EXPECT_NE(lines[105].find(",0.2,0.2,1,0"), std::string::npos) << lines[105];
+  EXPECT_NE(lines[105].find(",0.2,0.2,1,0,0"), std::string::npos) << lines[105];
 
   const auto j = nlohmann::json::parse(metrics_json(run.metrics));
   EXPECT_EQ(j["recovery_frames"], 31);
-  EXPECT_EQ(j["integrity"]["misleading_frames"], 4);
+  EXPECT_EQ(j["integrity"]["misleading_frames"], 0);
+  EXPECT_EQ(j["integrity"]["misleading_awaiting_alert"], 4);
+  EXPECT_EQ(j["integrity"]["frames_awaiting_alert"], 4);
   EXPECT_EQ(j["recovery"][1]["event"], "kidnap");
   EXPECT_NEAR(j["recovery"][1]["converged_after_s"].get<double>(), 1.5, 1e-9);
   EXPECT_TRUE(j["recovery"][0]["lost_raised_after_s"].is_null());
-  EXPECT_GT(j["consistency"]["mean_nees_lateral"].get<double>(), 1.0);  // the kidnap's unlost frames
+  EXPECT_DOUBLE_EQ(j["consistency"]["mean_nees_lateral"].get<double>(), 0.0);  // the 4 m frames await the alert
   EXPECT_EQ(j["thresholds"]["alert_limit_lateral_m"], kLocalStreetAlertLimit_m);
   EXPECT_EQ(j["thresholds"]["recovery"]["within_s"], 3.0);
 }
