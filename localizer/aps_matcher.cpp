@@ -192,27 +192,92 @@ Eigen::Vector2d IntensityGrid::cell_centre(int col, int row) const {
           (row + 0.5 - 0.5 * params.height_cells) * params.cell_m};
 }
 
+IntensityGridBuilder::IntensityGridBuilder(const Pose2d& pose, const IntensityGridParams& params)
+    : pose_(pose), params_(params) {
+  check_grid_params(params, "IntensityGridBuilder");
+  const size_t cells = size_t(params.width_cells) * size_t(params.height_cells);
+  count_.assign(cells, 0);
+  sum_.assign(cells, 0.0);
+  sum_sq_.assign(cells, 0.0);
+}
+
+std::optional<size_t> intensity_cell_index(const IntensityGridParams& params, const Eigen::Vector2d& point_vehicle) {
+  // Columns and rows from 0 at the grid's edge; `!(a >= 0 && a < n)` also refuses a NaN.
+  const double col = point_vehicle.x() / params.cell_m + 0.5 * params.width_cells;
+  const double row = point_vehicle.y() / params.cell_m + 0.5 * params.height_cells;
+  if (!(col >= 0 && col < params.width_cells && row >= 0 && row < params.height_cells)) return std::nullopt;
+  return size_t(row) * size_t(params.width_cells) + size_t(col);  // floor: both are >= 0
+}
+
+std::vector<char> cells_near_obstacles(const std::vector<Eigen::Vector2d>& obstacles, const IntensityGridParams& p) {
+  check_grid_params(p, "cells_near_obstacles");
+  const int w = p.width_cells, h = p.height_cells;
+  std::vector<char> near(size_t(w) * size_t(h), 0);
+  if (!(p.obstacle_distance > 0)) return near;
+  const int reach = int(std::ceil(p.obstacle_distance / p.cell_m)) + 1;
+  const double d2 = p.obstacle_distance * p.obstacle_distance;
+  for (const Eigen::Vector2d& o : obstacles) {
+    const double col = std::floor(o.x() / p.cell_m + 0.5 * w), row = std::floor(o.y() / p.cell_m + 0.5 * h);
+    // Off S by more than the reach (or not finite): no cell of S is that close.
+    if (!(col >= -reach && col < w + reach && row >= -reach && row < h + reach)) continue;
+    const int c0 = int(col), r0 = int(row);
+    for (int r = std::max(r0 - reach, 0); r <= std::min(r0 + reach, h - 1); ++r)
+      for (int c = std::max(c0 - reach, 0); c <= std::min(c0 + reach, w - 1); ++c) {
+        const Eigen::Vector2d centre((c + 0.5 - 0.5 * w) * p.cell_m, (r + 0.5 - 0.5 * h) * p.cell_m);
+        if ((centre - o).squaredNorm() <= d2) near[size_t(r) * size_t(w) + size_t(c)] = 1;
+      }
+  }
+  return near;
+}
+
+bool IntensityGridBuilder::add(const Eigen::Vector2d& point_vehicle, double intensity) {
+  if (!std::isfinite(intensity)) return false;
+  const std::optional<size_t> cell = intensity_cell_index(params_, point_vehicle);
+  if (!cell) return false;
+  const size_t k = *cell;
+  ++count_[k];
+  sum_[k] += intensity;
+  sum_sq_[k] += intensity * intensity;
+  return true;
+}
+
+void IntensityGridBuilder::add(const std::vector<Eigen::Vector2d>& points_vehicle,
+                               const std::vector<double>& intensities) {
+  if (points_vehicle.size() != intensities.size())
+    throw std::invalid_argument("IntensityGridBuilder::add: " + std::to_string(points_vehicle.size()) + " points but " +
+                                std::to_string(intensities.size()) + " intensities");
+  for (size_t i = 0; i < points_vehicle.size(); ++i) add(points_vehicle[i], intensities[i]);
+}
+
+long IntensityGridBuilder::cells_with_more_than(uint32_t points) const {
+  return long(std::count_if(count_.begin(), count_.end(), [points](uint32_t n) { return n > points; }));
+}
+
+IntensityGrid IntensityGridBuilder::grid() const {
+  IntensityGrid grid;
+  grid.pose = pose_;
+  grid.params = params_;
+  grid.cells.resize(count_.size());
+  for (size_t k = 0; k < count_.size(); ++k) {
+    if (count_[k] == 0) continue;
+    // Eq. 8's mean and spread from the sums; intensities are counts up to a few hundred, so the sum of
+    // squares stays exact to far below a count's square even for thousands of points.
+    const double n = double(count_[k]), mean = sum_[k] / n;
+    grid.cells[k] = {count_[k], float(mean), float(std::max(0.0, sum_sq_[k] - sum_[k] * mean))};
+  }
+  return grid;
+}
+
 IntensityGrid build_intensity_grid(const std::vector<Eigen::Vector3d>& ground_points_vehicle,
                                    const std::vector<double>& intensities, const Pose2d& pose,
                                    const IntensityGridParams& params) {
-  check_grid_params(params, "build_intensity_grid");
+  IntensityGridBuilder builder(pose, params);
   if (ground_points_vehicle.size() != intensities.size())
     throw std::invalid_argument("build_intensity_grid: " + std::to_string(ground_points_vehicle.size()) +
                                 " points but " + std::to_string(intensities.size()) + " intensities");
-  IntensityGrid grid;
-  grid.pose = pose;
-  grid.params = params;
-  grid.cells.assign(size_t(params.width_cells) * size_t(params.height_cells), IntensityCell{});
-  const double half_w = 0.5 * params.width_cells, half_h = 0.5 * params.height_cells;
-  for (size_t i = 0; i < ground_points_vehicle.size(); ++i) {
-    const Eigen::Vector3d& p = ground_points_vehicle[i];
-    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(intensities[i])) continue;
-    const double col = std::floor(p.x() / params.cell_m + half_w);
-    const double row = std::floor(p.y() / params.cell_m + half_h);
-    if (col < 0 || row < 0 || col >= params.width_cells || row >= params.height_cells) continue;
-    grid.cells[size_t(row) * size_t(params.width_cells) + size_t(col)].add(intensities[i]);  // Eq. 8
-  }
-  return grid;
+  for (size_t i = 0; i < ground_points_vehicle.size(); ++i)
+    builder.add(ground_points_vehicle[i].head<2>(), intensities[i]);
+  return builder.grid();
 }
 
 ApsSearchWindow aps_search_window(const ApsParams& params, double cell_m) {

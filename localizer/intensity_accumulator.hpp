@@ -29,8 +29,7 @@ class IntensityAccumulator {
   // `motion_since_previous` as Eq. 5 takes it (relative(previous pose, current pose)). An empty scan is
   // a frame too, so the older ones stay where they are relative to the car. Throws
   // std::invalid_argument for mismatched sizes.
-  void add(const std::vector<Eigen::Vector2d>& ground, const std::vector<double>& intensities,
-           const Pose2d& motion_since_previous);
+  void add(std::vector<Eigen::Vector2d> ground, std::vector<double> intensities, const Pose2d& motion_since_previous);
 
   // S (Eq. 8) over all kept frames, placed at `pose` (the prior of the match), with its redundancy:
   // the cells with more than `min_count` points (APS's n_e) over those of the newest frame alone.

@@ -472,6 +472,19 @@ std::optional<IntensityCell> IntensityMap::cell(const Eigen::Vector2d& xy) {
   return value;
 }
 
+size_t IntensityMap::preload(const Eigen::Vector2d& centre, double half_extent) {
+  const auto lo = try_cell_index(header_, centre - Eigen::Vector2d::Constant(half_extent));
+  const auto hi = try_cell_index(header_, centre + Eigen::Vector2d::Constant(half_extent));
+  if (!lo || !hi) return 0;
+  size_t read = 0;
+  for (int ty = lo->tile_y; ty <= hi->tile_y; ++ty)
+    for (int tx = lo->tile_x; tx <= hi->tile_x; ++tx) {
+      if (read >= max_cached_) return read;  // more would evict the first
+      if (tile(tx, ty) != nullptr) ++read;
+    }
+  return read;
+}
+
 // The returned pointer is valid until the next call (which may evict it).
 const std::vector<IntensityCell>* IntensityMap::tile(int tx, int ty) {
   const std::pair<int, int> key{tx, ty};

@@ -136,6 +136,9 @@ class IntensityMap {
   const IntensityMapHeader& header() const { return header_; }
   // The cell at a local point, if the map has data there.
   std::optional<IntensityCell> cell(const Eigen::Vector2d& xy);
+  // Reads the tiles the square of +-half_extent around `centre` touches into the cache now (at most as
+  // many as it holds), so that the first lookups there do not pay for the disk; how many it holds.
+  size_t preload(const Eigen::Vector2d& centre, double half_extent);
   size_t cached_tiles() const { return cache_.size(); }
   size_t tiles_loaded() const { return loads_; }  // how many tile reads so far
 

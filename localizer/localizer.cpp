@@ -97,22 +97,25 @@ std::vector<Eigen::Vector2d> detect_scan_curbs(const ScanPoints& points, const s
 }
 
 // 2.2.2: grid S of the road surface's intensities around the vehicle (Eq. 8), placed at `pose`, from
-// this scan's ground and the frames before it (intensity_accumulator.hpp), each laser's reading first
-// put on the map's scale (beyond the paper: intensity_calibration.hpp).
-IntensityGrid intensity_grid(const ScanPoints& points, const std::vector<size_t>& ground, const Pose2d& pose,
-                             const Pose2d& motion, const IntensityGridParams& params, int min_count,
-                             const IntensityCalibration& calibration, IntensityAccumulator& accumulator,
-                             LocalizerEstimate& e) {
+// this scan's ground away from its obstacles and the frames before it (intensity_accumulator.hpp), each
+// laser's reading first put on the map's scale (beyond the paper: intensity_calibration.hpp).
+IntensityGrid intensity_grid(const ScanPoints& points, const std::vector<size_t>& ground,
+                             const std::vector<Eigen::Vector2d>& obstacles, const Pose2d& pose, const Pose2d& motion,
+                             const IntensityGridParams& params, int min_count, const IntensityCalibration& calibration,
+                             IntensityAccumulator& accumulator, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::intensity_matching));
+  const std::vector<char> near_obstacle = cells_near_obstacles(obstacles, params);
   std::vector<Eigen::Vector2d> ground_xy;
   std::vector<double> intensities;
   ground_xy.reserve(ground.size());
   intensities.reserve(ground.size());
   for (size_t i : ground) {
+    const std::optional<size_t> cell = intensity_cell_index(params, points.xyz[i].head<2>());
+    if (cell && near_obstacle[*cell]) continue;
     ground_xy.push_back(points.xyz[i].head<2>());
     intensities.push_back(calibration.correct(points.ring[i], points.intensity[i]));
   }
-  accumulator.add(ground_xy, intensities, motion);
+  accumulator.add(std::move(ground_xy), std::move(intensities), motion);
   return accumulator.grid(pose, params, min_count);
 }
 
@@ -258,6 +261,14 @@ void Localizer::on_gps(const GpsFix& fix) {
     last_fix_ = {filter_->pose(), R};
     lost_.start_search();
     trusted_.reset();
+    // The map's intensity tiles where the first scans will read them (S's reach and the wide search's),
+    // read now rather than inside the first scan's budget, as a map loader reads around the first fix.
+    if (uses_intensity(params_.method)) {
+      const IntensityGridParams& g = params_.intensity_grid;
+      const RelocalizationParams& r = params_.relocalization;
+      map_.intensity.preload(p, 0.5 * std::max(g.width_cells, g.height_cells) * g.cell_m +
+                                    std::max(r.max_longitudinal_m, r.max_lateral_m));
+    }
     return;
   }
   last_fix_ = {Pose2d{p.x(), p.y(), filter_->pose().yaw}, R};
@@ -372,8 +383,8 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
     calibrate_lasers_to_each_other(points, ground);
   }
   if (uses_intensity(method))  // 2.2.2
-    S = intensity_grid(points, ground, filter_->pose(), motion, params_.intensity_grid, params_.aps.min_count,
-                       intensity_calibration_, intensity_accumulator_, e);
+    S = intensity_grid(points, ground, features_.obstacles, filter_->pose(), motion, params_.intensity_grid,
+                       params_.aps.min_count, intensity_calibration_, intensity_accumulator_, e);
 
   // While lost the narrow matchers (their windows grown to the filter's doubt) and the GPS still
   // converge the filter as they can (a search may find nothing for long); the search starts afresh

@@ -213,6 +213,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("cell_m", p.intensity_grid.cell_m, 0.01, 2.0)
       .number("max_height", p.intensity_grid.max_height, 0.01, 10.0)
       .integer("frames", p.intensity_grid.frames, 1, 100)
+      .number("obstacle_distance", p.intensity_grid.obstacle_distance, 0.0, 10.0)
       .number("max_turn_deg", p.intensity_grid.max_turn_deg, 0.0, 180.0)
       .done();
   YamlMap(y, top["intensity_calibration"], "intensity_calibration")

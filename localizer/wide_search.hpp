@@ -14,8 +14,9 @@
 //
 // Budget: the localizer's scan takes 5-10 ms of a p50 8 ms / p99 20 ms budget, so the search is made of
 // units (one yaw slice of the coarse grid, one candidate's refinement) and WideApsSearch::step runs as
-// many as a budget of z-score terms allows, resuming on the next scan: 3-6 ms of CPU a step, five steps
-// (bench_wide_search; the whole search in one call is ~20 ms). Candidates are kept as
+// many as a budget of z-score terms allows, resuming on the next scan: 3-6 ms of CPU a step, five or six
+// steps (the one that ends the coarse phase stops there; bench_wide_search; the whole search in one call
+// is ~20 ms). Candidates are kept as
 // corrections of the prior (rigid transforms of the local frame: pose = correction * prior), which stay
 // valid while the prior moves with odometry.
 //
@@ -71,7 +72,7 @@ struct WideApsParams {
   // Work per WideApsSearch::step, in z-score terms of Eq. 14 (one cell of S at one pose). The coarse
   // phase is ~1.5 M terms and each refinement ~2.3 M for Table I's S over a 12 m wide road, so the
   // default runs one of them per step: 3-6 ms on one core with the map reads (bench_wide_search), five
-  // steps in all, the last with the verdict. A unit is never split: a step does at least one.
+  // or six steps in all, the last with the verdict. A unit is never split: a step does at least one.
   int64_t max_terms_per_step = 2'500'000;
 };
 
@@ -121,8 +122,8 @@ struct WideApsCandidate {
   double yaw_variance = 0;
 };
 
-// The search in one go: WideApsSearch with an unlimited budget. S.pose is the prior and the window's
-// centre. Throws std::invalid_argument if S's cell is not the map's or a parameter is out of range.
+// The search in one go: WideApsSearch with an unlimited budget, stepped on the same S until done. S.pose is the prior
+// and the window's centre. Throws std::invalid_argument if S's cell is not the map's or a parameter is out of range.
 WideApsResult wide_aps_search(const IntensityGrid& S, IntensityMap& map, const WideApsParams& params = {});
 
 // The same search spread over scans. Each step takes the newest S (S.pose its prior) and runs units of

@@ -16,7 +16,7 @@ std::vector<FaultEvent> fault_events(const Scenario& scenario, int64_t start_ns)
   for (const GpsZone& z : scenario.gps.zones) {
     if (z.kind != GpsZone::Kind::multipath || z.radius_m > 0) continue;
     add(z.from_ns, "gps jump");
-    add(z.to_ns, "gps jump");
+    add(z.to_ns, "gps jump back");
   }
   // Stable: the start stays first among events at its stamp, the rest keep the scenario's order.
   std::stable_sort(events.begin(), events.end(),

@@ -14,9 +14,11 @@ namespace lidarloop {
 // sample one truth period later), so a fault at `at_s` is at stamp at_s * 1e9.
 //   "start"     at `start_ns`, the run's first truth stamp (the localizer's cold start)
 //   "kidnap"    at each kidnap's at_s
-//   "gps jump"  at each multipath zone's from_s and again at its to_s, when the fix jumps back; only
-//               zones in time alone: a zone with a radius jumps where the car enters it, which the
-//               scenario does not say (it needs the drive), so it gives no event here.
+//   "gps jump"  at each multipath zone's from_s, and "gps jump back" at its to_s, when the fix returns
+//               to the truth (a localizer that held the map's pose through the jump has nothing to be
+//               lost about then: the scorer asks it only to stay converged); only zones in time alone:
+//               a zone with a radius jumps where the car enters it, which the scenario does not say (it
+//               needs the drive), so it gives no event here.
 // Sorted by stamp (ties in the order above); events before `start_ns` are dropped (a zone from 0 s is
 // in force at the start, and the cold start is its event), as are zone ends at or beyond the scenario's
 // duration (the fix never jumps back within the run).

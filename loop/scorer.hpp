@@ -78,7 +78,7 @@ struct EstimateRecord {
 // faults). The scorer measures how long after it the error settles and `lost` is raised and cleared.
 struct FaultEvent {
   int64_t stamp_ns = 0;
-  std::string what;  // "start", "gps jump", "kidnap"
+  std::string what;  // "start", "gps jump", "gps jump back", "kidnap"
 };
 
 // And, for the run's occlusion, the simulator's per-scan curb visibility (common/curb_visibility.hpp):

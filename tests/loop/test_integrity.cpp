@@ -247,6 +247,20 @@ TEST(Recovery, AKidnapIsMeasuredFromItsEventAndKeptOutOfTheAccuracy) {
             std::vector<std::string>{"start at 0.00 s: lost was never cleared"});
 }
 
+TEST(Recovery, AGpsJumpBackNeedsNoLostButAJumpDoes) {
+  // The localizer held the map's pose: never lost, never off.
+  const auto steady = estimates(
+      20, [](double) { return 0.0; }, [](double) { return false; });
+  PassThresholds t;
+  t.recovery = PassThresholds::Recovery{};
+  auto failures = [&](const std::string& what) {
+    return score(straight_truth(20), steady, straight_route(), t, "m", "s", {{0, "start"}, {10'000 * kMs, what}})
+        .metrics.failures;
+  };
+  EXPECT_EQ(failures("gps jump back"), std::vector<std::string>{});
+  EXPECT_EQ(failures("gps jump"), std::vector<std::string>{"gps jump at 10.00 s: lost was never raised"});
+}
+
 TEST(PassGates, EachIntegrityAndConsistencyKeyGatesThePass) {
   // Lateral error 0.1 m against sigma 0.1 m: NEES 1 lateral, 0 on the others; bounds 0.2 m never
   // exceeded; available under the default 0.29 m alert limits.
@@ -303,8 +317,9 @@ TEST(FaultEvents, TheStartKidnapsAndTimedGpsJumpsInTimeOrder) {
   s.gps.zones = {jump, spatial, outage, from_start, endless};
   const std::vector<FaultEvent> events = fault_events(s, 10 * kMs);  // the first truth sample
   const std::vector<std::pair<int64_t, std::string>> expected = {
-      {10 * kMs, "start"},        {5'000 * kMs, "gps jump"}, {10'000 * kMs, "kidnap"},  {20'000 * kMs, "gps jump"},
-      {25'000 * kMs, "gps jump"}, {30'000 * kMs, "kidnap"},  {50'000 * kMs, "gps jump"}};
+      {10 * kMs, "start"},        {5'000 * kMs, "gps jump back"},  {10'000 * kMs, "kidnap"},
+      {20'000 * kMs, "gps jump"}, {25'000 * kMs, "gps jump back"}, {30'000 * kMs, "kidnap"},
+      {50'000 * kMs, "gps jump"}};
   ASSERT_EQ(events.size(), expected.size());
   for (size_t i = 0; i < events.size(); ++i) {
     EXPECT_EQ(events[i].stamp_ns, expected[i].first) << i;
