@@ -46,9 +46,9 @@ TEST(IntensityObstacleMask, AnObstacleJustOffTheGridStillMarksTheEdge) {
 }
 
 TEST(IntensityObstacleMask, ZeroDistanceOrNoObstaclesMarkNothing) {
-  for (const std::vector<char>& mask : {cells_near_obstacles({{5.1, 0.1}}, params(0.0)),
-                                        cells_near_obstacles({}, params(0.5)),
-                                        cells_near_obstacles({{1e9, 0.0}, {NAN, 0.0}}, params(0.5))}) {
+  for (const std::vector<char>& mask :
+       {cells_near_obstacles({{5.1, 0.1}}, params(0.0)), cells_near_obstacles({}, params(0.5)),
+        cells_near_obstacles({{1e9, 0.0}, {NAN, 0.0}}, params(0.5))}) {
     int marked = 0;
     for (char m : mask) marked += m;
     EXPECT_EQ(marked, 0);
