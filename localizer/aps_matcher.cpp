@@ -170,6 +170,40 @@ ZScoreSums z_score_sums(const IntensityGrid& S, const MapWindow& m, const ApsSea
   return sums;
 }
 
+// ApsResult::yaw_coupling in the vehicle frame, at offset (i, j) of the window: the translation t that
+// best undoes a turn e of S minimises sum w (g . (t + e perp(c)))^2 over the cells taking part, with g
+// the map's intensity gradient under cell c (central differences), w = 1 / (m_sigma + s_sigma)^2 and
+// perp(c) = (-c_y, c_x); t = -e A^-1 b. A direction the gradients leave free gets no coupling (A is
+// regularised by a millionth of its trace).
+Eigen::Vector2d yaw_coupling(const IntensityGrid& S, const MapWindow& m, const ApsSearchWindow& window,
+                             const ApsParams& params, int i, int j) {
+  const int w = S.params.width_cells, h = S.params.height_cells;
+  const double cell = S.params.cell_m;
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  for (int r = 0; r < h; ++r) {
+    for (int c = 0; c < w; ++c) {
+      const IntensityCell& s = S.cells[size_t(r) * size_t(w) + size_t(c)];
+      if (!usable(s, params)) continue;
+      if (m.missing.in(c, r, 2 * window.margin_x() + 1, 2 * window.margin_y() + 1) != 0) continue;
+      const int wc = c + i * window.step_cells, wr = r + j * window.step_cells;
+      if (wc < 1 || wr < 1 || wc + 1 >= m.cols || wr + 1 >= m.rows) continue;
+      const float left = m.mean[m.index(wc - 1, wr)], right = m.mean[m.index(wc + 1, wr)];
+      const float down = m.mean[m.index(wc, wr - 1)], up = m.mean[m.index(wc, wr + 1)];
+      if (std::isnan(left) || std::isnan(right) || std::isnan(down) || std::isnan(up)) continue;
+      const Eigen::Vector2d g((right - left) / (2 * cell), (up - down) / (2 * cell));
+      const double e = m.sigma[m.index(wc, wr)] + floored_sigma(s, params.min_sigma);
+      const Eigen::Matrix2d G = g * g.transpose() / (e * e);
+      const Eigen::Vector2d centre = S.cell_centre(c, r) + window.offset(i, j);
+      A += G;
+      b += G * Eigen::Vector2d(-centre.y(), centre.x());
+    }
+  }
+  const double trace = A.trace();
+  if (!(trace > 0)) return Eigen::Vector2d::Zero();
+  return -(A + 1e-6 * trace * Eigen::Matrix2d::Identity()).ldlt().solve(b);
+}
+
 // No information beyond "somewhere in the window": a uniform spread over it (variance range^2 / 3),
 // vehicle frame.
 Eigen::Matrix2d uniform_over_window(const ApsSearchWindow& window) {
@@ -363,6 +397,10 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
   result.offset_vehicle = moments.mean;
   result.position = origin + R * moments.mean;  // Eq. 17-18, the offset rotated from the vehicle frame
   result.covariance = R * moments.covariance * R.transpose();
+  // At the offset nearest the centre of mass.
+  const int i = std::clamp(int(std::lround(moments.mean.x() / window.step_m)) + window.nx, 0, window.offsets_x() - 1);
+  const int j = std::clamp(int(std::lround(moments.mean.y() / window.step_m)) + window.ny, 0, window.offsets_y() - 1);
+  result.yaw_coupling = R * yaw_coupling(S, under_s, window, params, i, j);
   const Eigen::Vector2d uniform = uniform_over_window(window).diagonal();
   for (int k = 0; k < 2; ++k) result.spread_ratio[k] = uniform[k] > 0 ? moments.covariance(k, k) / uniform[k] : 1.0;
   return result;

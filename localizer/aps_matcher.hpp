@@ -128,6 +128,12 @@ struct ApsResult {
   // window's extent on it; near 1 the match says nothing on that axis. 1 for an axis not searched.
   Eigen::Vector2d spread_ratio = Eigen::Vector2d::Ones();
   int cells_used = 0;  // cells of S that entered Eq. 14
+  // How far the match moves per radian of error in the prior's heading (local frame, m/rad). APS
+  // searches x and y at the prior's yaw: S turned by an error e about the car moves its paint by e
+  // times each cell's distance, and the best offset follows by about yaw_coupling * e. The Lucas-Kanade
+  // estimate at the best offset: the cells' rotation field projected on the map's intensity gradients,
+  // each weighted by Eq. 14's z-score denominator. Zero when not ok.
+  Eigen::Vector2d yaw_coupling = Eigen::Vector2d::Zero();
   // The most probable offset lies on the window's border: the true one may well be outside, and the
   // centroid is then pulled towards the middle of a window that does not contain it.
   bool peak_on_edge = false;

@@ -659,7 +659,14 @@ void Localizer::fuse_intensity(const ApsResult& aps, double redundancy, Localize
   // innovations have shown of it so far (innovation_scale.hpp).
   const Eigen::Matrix2d claimed = aps.covariance * params_.aps_covariance_scale * redundancy;
   const Eigen::Matrix2d R = scaled_along_across(claimed, prior.yaw, aps_scale_.scale());
-  const Eigen::Matrix2d S = filter_->covariance().topLeftCorner<2, 2>() + R;
+  // APS matched at the prior's heading: a heading error moves its answer by yaw_coupling per radian,
+  // so the observation is z = p + J (psi_prior - psi) and its gate counts the heading's doubt; in a
+  // bend or with paint on one side of the car the update then also corrects the heading.
+  const Eigen::Vector2d& J = aps.yaw_coupling;
+  Eigen::Matrix<double, 2, 3> H = Eigen::Matrix<double, 2, 3>::Zero();
+  H(0, 0) = H(1, 1) = 1;
+  H.col(2) = -J;
+  const Eigen::Matrix2d S = H * filter_->covariance() * H.transpose() + R;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
     e.health |= kIntensityMatchRejected;
     disagree(innovation);
@@ -686,9 +693,9 @@ void Localizer::fuse_intensity(const ApsResult& aps, double redundancy, Localize
   const bool along = informative(0, forward, params_.aps.longitudinal_range_m);
   const bool across = informative(1, left, params_.aps.lateral_range_m) && !curbs_hold_lateral;
   if (along && across)
-    filter_->update_intensity(aps.position, R);  // KF2
+    filter_->update_intensity(aps.position, R, J);  // KF2
   else if (along || across)
-    filter_->update_intensity_along(aps.position, R, along ? forward : left);
+    filter_->update_intensity_along(aps.position, R, along ? forward : left, J);
   else
     e.health |= kIntensityAmbiguous;
   if (along || across) {

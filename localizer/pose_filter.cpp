@@ -84,17 +84,21 @@ void PoseFilter::update_curb(const Eigen::Vector3d& z, const Eigen::Matrix3d& R)
   update<3>(z, R, Eigen::Matrix3d::Identity());
 }
 
-void PoseFilter::update_intensity(const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
+void PoseFilter::update_intensity(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& J) {
   Eigen::Matrix<double, 2, 3> H = Eigen::Matrix<double, 2, 3>::Zero();
   H(0, 0) = H(1, 1) = 1;
-  update<2>(z, R, H);
+  H.col(2) = -J;
+  // z = p + J (psi_prior - psi): the innovation stays z - p_prior.
+  update<2>(z - J * x_.z(), R, H);
 }
 
-void PoseFilter::update_intensity_along(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& u) {
+void PoseFilter::update_intensity_along(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& u,
+                                        const Eigen::Vector2d& J) {
   Eigen::Matrix<double, 1, 3> H = Eigen::Matrix<double, 1, 3>::Zero();
   H(0, 0) = u.x();
   H(0, 1) = u.y();
-  update<1>(Eigen::Matrix<double, 1, 1>(u.dot(z)), Eigen::Matrix<double, 1, 1>(u.dot(R * u)), H);
+  H(0, 2) = -u.dot(J);
+  update<1>(Eigen::Matrix<double, 1, 1>(u.dot(z - J * x_.z())), Eigen::Matrix<double, 1, 1>(u.dot(R * u)), H);
 }
 
 }  // namespace lidarloop

@@ -60,9 +60,13 @@ class PoseFilter {
   void update_gps(const Eigen::Vector3d& z, const Eigen::Matrix3d& R);
   // KF2: the curb matching observation (x_c, y_c, psi_c) and the intensity one (x_s, y_s).
   void update_curb(const Eigen::Vector3d& z, const Eigen::Matrix3d& R);
-  void update_intensity(const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
-  // The intensity observation's component along the unit direction `u` only (z and R as above).
-  void update_intensity_along(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& u);
+  // J: how the observation moves per radian of error in the heading it was made at (ApsResult's
+  // yaw_coupling): z = p + J (psi_prior - psi), so the update corrects the heading too.
+  void update_intensity(const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+                        const Eigen::Vector2d& J = Eigen::Vector2d::Zero());
+  // The intensity observation's component along the unit direction `u` only (z, R and J as above).
+  void update_intensity_along(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& u,
+                              const Eigen::Vector2d& J = Eigen::Vector2d::Zero());
   // Uncertainty the motion model does not know about (dead reckoning without CAN): P += Q.
   void inflate(const Eigen::Matrix3d& Q) { P_ += Q; }
 

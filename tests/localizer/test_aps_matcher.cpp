@@ -203,6 +203,31 @@ TEST_F(Aps, RecoversAKnownOffsetOnACrosswalkWithTheVehicleTurned) {
   EXPECT_GT((r.position - Eigen::Vector2d(prior.x, prior.y)).norm(), 1.0);
 }
 
+// A line along the road only ahead of the car, 5 to 20 m out: turning S by e about the car moves the
+// line's cells sideways by e times their distance, so the match slides across by about e times the
+// line's mean distance (12.5 m) and not along: yaw_coupling ~ (0, -12.5) m/rad, and the position APS
+// finds at a prior heading e off moves by it.
+bool line_ahead(const Eigen::Vector2d& p) { return p.x() >= 25 && p.x() < 40 && p.y() >= 0.2 && p.y() < 0.6; }
+
+TEST(ApsYawCoupling, ALineAheadSlidesSidewaysWithTheHeadingError) {
+  const std::string dir = build_map(line_ahead, "line_ahead", 5);
+  IntensityMap map(dir);
+  const Pose2d truth{20.0, 0.0, 0.0};
+  const IntensityGridParams g;
+  const Scan scan = scan_at(line_ahead, truth, g, 6);
+  const ApsResult at_truth = aps_match(build_intensity_grid(scan.points, scan.intensities, truth, g), map);
+  ASSERT_TRUE(at_truth.ok);
+  EXPECT_NEAR(at_truth.yaw_coupling.y(), -12.5, 2.5);
+  EXPECT_LT(std::fabs(at_truth.yaw_coupling.x()), 2.0);
+  // A prior heading 1 deg off: the lateral answer moves by J * e (-0.22 m), within a step.
+  const double e = std::numbers::pi / 180.0;
+  const ApsResult turned =
+      aps_match(build_intensity_grid(scan.points, scan.intensities, {truth.x, truth.y, truth.yaw + e}, g), map);
+  ASSERT_TRUE(turned.ok);
+  EXPECT_NEAR(turned.position.y() - at_truth.position.y(), at_truth.yaw_coupling.y() * e, kResolution);
+  fs::remove_all(dir);
+}
+
 TEST_F(Aps, AnErrorBeyondTheSearchWindowIsNotRecovered) {
   IntensityMap map(*crosswalk_dir_);
   const IntensityGridParams g;

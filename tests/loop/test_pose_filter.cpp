@@ -109,5 +109,30 @@ TEST(PoseFilter, AConfidentCurbObservationPullsThePoseToIt) {
   EXPECT_NEAR(std::abs(wrap.pose().yaw), M_PI, 1e-6);
 }
 
+TEST(PoseFilter, AnIntensityMatchCoupledToTheHeadingCorrectsTheHeading) {
+  // The car is at (10, 0) heading 0; the filter believes it heads 1 deg left, with 1 deg of doubt and
+  // the position known to 1 cm. APS, matched at the believed heading on a line 12.5 m ahead, answers
+  // p + J (psi_prior - psi) with J = (0, -12.5) m/rad: 0.22 m to the right.
+  const double e = M_PI / 180;
+  const Eigen::Vector2d J(0, -12.5);
+  const Eigen::Vector2d z = Eigen::Vector2d(10, 0) + J * e;
+  const Eigen::Matrix3d P = Eigen::Vector3d(1e-4, 1e-4, e * e).asDiagonal();
+  const Eigen::Matrix2d R = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
+  PoseFilter coupled({10, 0, e}, P);
+  coupled.update_intensity(z, R, J);
+  // The heading takes most of the correction (its doubt is 22 cm at the line, the position's 1 cm).
+  EXPECT_LT(std::abs(coupled.pose().yaw), 0.2 * e);
+  EXPECT_NEAR(coupled.pose().y, 0.0, 0.02);
+  // Without the coupling the position is dragged instead, and the heading stays wrong.
+  PoseFilter plain({10, 0, e}, P);
+  plain.update_intensity(z, R);
+  EXPECT_NEAR(plain.pose().yaw, e, 1e-9);
+  EXPECT_LT(plain.pose().y, -0.1);
+  // Along one direction only (the lateral here), the same.
+  PoseFilter along({10, 0, e}, P);
+  along.update_intensity_along(z, R, {0, 1}, J);
+  EXPECT_LT(std::abs(along.pose().yaw), 0.2 * e);
+}
+
 }  // namespace
 }  // namespace lidarloop
