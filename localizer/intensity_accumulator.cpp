@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include <Eigen/Geometry>
+#include "localizer/curb_features.hpp"
 
 namespace lidarloop {
 
@@ -21,11 +21,8 @@ void IntensityAccumulator::add(std::vector<Eigen::Vector2d> ground, std::vector<
   if (ground.size() != intensities.size())
     throw std::invalid_argument("IntensityAccumulator::add: " + std::to_string(ground.size()) + " points but " +
                                 std::to_string(intensities.size()) + " intensities");
-  // Eq. 5, in place: R(-dpsi) (C - d).
-  const Eigen::Rotation2Dd back(-motion.yaw);
-  const Eigen::Vector2d d(motion.x, motion.y);
   for (Frame& frame : history_) {
-    for (Eigen::Vector2d& p : frame.ground) p = back * (p - d);
+    frame.ground = to_current_frame(frame.ground, motion);  // Eq. 5
     frame.turn_rad += motion.yaw;
   }
   history_.push_front({std::move(ground), std::move(intensities), 0.0});

@@ -663,9 +663,7 @@ void Localizer::fuse_intensity(const ApsResult& aps, double redundancy, Localize
   // so the observation is z = p + J (psi_prior - psi) and its gate counts the heading's doubt; in a
   // bend or with paint on one side of the car the update then also corrects the heading.
   const Eigen::Vector2d& J = aps.yaw_coupling;
-  Eigen::Matrix<double, 2, 3> H = Eigen::Matrix<double, 2, 3>::Zero();
-  H(0, 0) = H(1, 1) = 1;
-  H.col(2) = -J;
+  const Eigen::Matrix<double, 2, 3> H = intensity_observation_matrix(J);
   const Eigen::Matrix2d S = H * filter_->covariance() * H.transpose() + R;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
     e.health |= kIntensityMatchRejected;

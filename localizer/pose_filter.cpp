@@ -84,20 +84,20 @@ void PoseFilter::update_curb(const Eigen::Vector3d& z, const Eigen::Matrix3d& R)
   update<3>(z, R, Eigen::Matrix3d::Identity());
 }
 
+Eigen::Matrix<double, 2, 3> intensity_observation_matrix(const Eigen::Vector2d& J) {
+  Eigen::Matrix<double, 2, 3> H;
+  H << 1, 0, -J.x(), 0, 1, -J.y();
+  return H;
+}
+
+// z = p + J (psi_prior - psi), i.e. z - J psi_prior = H x: the innovation stays z - p_prior.
 void PoseFilter::update_intensity(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& J) {
-  Eigen::Matrix<double, 2, 3> H = Eigen::Matrix<double, 2, 3>::Zero();
-  H(0, 0) = H(1, 1) = 1;
-  H.col(2) = -J;
-  // z = p + J (psi_prior - psi): the innovation stays z - p_prior.
-  update<2>(z - J * x_.z(), R, H);
+  update<2>(z - J * x_.z(), R, intensity_observation_matrix(J));
 }
 
 void PoseFilter::update_intensity_along(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& u,
                                         const Eigen::Vector2d& J) {
-  Eigen::Matrix<double, 1, 3> H = Eigen::Matrix<double, 1, 3>::Zero();
-  H(0, 0) = u.x();
-  H(0, 1) = u.y();
-  H(0, 2) = -u.dot(J);
+  const Eigen::Matrix<double, 1, 3> H = u.transpose() * intensity_observation_matrix(J);
   update<1>(Eigen::Matrix<double, 1, 1>(u.dot(z - J * x_.z())), Eigen::Matrix<double, 1, 1>(u.dot(R * u)), H);
 }
 

@@ -50,6 +50,10 @@ struct PoseFilterParams {
   double position_per_sqrt_s = 0.2;
 };
 
+// The intensity observation's H: z = p + J (psi_prior - psi) is linear in (x, y, psi) with rows
+// [I, -J] (J: ApsResult::yaw_coupling; zero for a match that does not depend on the heading).
+Eigen::Matrix<double, 2, 3> intensity_observation_matrix(const Eigen::Vector2d& J);
+
 class PoseFilter {
  public:
   PoseFilter(const Pose2d& initial, const Eigen::Matrix3d& covariance, const PoseFilterParams& params = {});
