@@ -581,7 +581,8 @@ void WideApsSearch::step(const IntensityGrid& S, IntensityMap& map) {
       next_unit_ = 0;
       // The step that ends the coarse phase refines nothing: building the coarse level reads the map
       // over the whole window, which the terms do not count, and with a refinement after it one step
-      // took 17 ms of a cold start's scan (bench localizer).
+      // took 17 ms of a cold start's scan (bench localizer, timed by hand around the step; the scans
+      // with a wide search went from 26-28 ms to 14-15 ms at p99).
       if (phase_ == Phase::fine) {
         result_.offsets_evaluated = offsets_;
         result_.terms_evaluated = terms_;
