@@ -55,6 +55,9 @@ struct IntensityGrid {
   // without the match being that many times more accurate, so the caller widens APS's covariance by
   // this (measured on closed_loop_campus: longitudinal NEES 3.1 with one scan, 6.8 with five unwidened).
   double redundancy = 1.0;
+  // The car turned more than IntensityGridParams::max_turn_deg since the previous scan: S is this scan's
+  // alone, and its paint is seen across a bend, where APS errs differently (see Localizer's APS scales).
+  bool turning = false;
 
   // Throws std::out_of_range outside the grid.
   const IntensityCell& at(int col, int row) const;

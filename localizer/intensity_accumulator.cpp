@@ -21,6 +21,7 @@ void IntensityAccumulator::add(std::vector<Eigen::Vector2d> ground, std::vector<
   if (ground.size() != intensities.size())
     throw std::invalid_argument("IntensityAccumulator::add: " + std::to_string(ground.size()) + " points but " +
                                 std::to_string(intensities.size()) + " intensities");
+  last_turn_rad_ = motion.yaw;
   for (Frame& frame : history_) {
     frame.ground = to_current_frame(frame.ground, motion);  // Eq. 5
     frame.turn_rad += motion.yaw;
@@ -39,6 +40,7 @@ IntensityGrid IntensityAccumulator::grid(const Pose2d& pose, const IntensityGrid
     if (&frame == &history_.front()) newest_cells = builder.cells_with_more_than(n_e);
   }
   IntensityGrid S = builder.grid();
+  S.turning = std::abs(last_turn_rad_) > max_turn_rad_;
   if (newest_cells > 0) S.redundancy = std::max(1.0, double(builder.cells_with_more_than(n_e)) / double(newest_cells));
   return S;
 }

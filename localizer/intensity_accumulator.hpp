@@ -32,7 +32,8 @@ class IntensityAccumulator {
   void add(std::vector<Eigen::Vector2d> ground, std::vector<double> intensities, const Pose2d& motion_since_previous);
 
   // S (Eq. 8) over all kept frames, placed at `pose` (the prior of the match), with its redundancy:
-  // the cells with more than `min_count` points (APS's n_e) over those of the newest frame alone.
+  // the cells with more than `min_count` points (APS's n_e) over those of the newest frame alone; and
+  // whether the last motion turned the car beyond max_turn_rad (IntensityGrid::turning).
   IntensityGrid grid(const Pose2d& pose, const IntensityGridParams& params, int min_count) const;
 
   size_t points() const;
@@ -46,6 +47,7 @@ class IntensityAccumulator {
   int frames_;
   double max_turn_rad_;
   std::deque<Frame> history_;  // newest first
+  double last_turn_rad_ = 0;   // the heading change of the last motion added
 };
 
 }  // namespace lidarloop

@@ -407,7 +407,7 @@ void Localizer::match_and_fuse(IntensityGrid* S, LocalizerEstimate& e) {
   }
   if (S) {
     const std::optional<ApsResult> z = match_intensity(*S, e);  // 3.2
-    if (z) fuse_intensity(*z, S->redundancy, e);                // 3.3
+    if (z) fuse_intensity(*z, *S, e);                           // 3.3
   }
 }
 
@@ -492,7 +492,10 @@ std::optional<Localizer::PoseObservation> Localizer::match_curbs(const std::vect
     return std::nullopt;
   }
   const Eigen::Vector2d corrected_xy = t->apply(xy(prior));
-  const Pose2d z{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t->yaw)};
+  Pose2d z{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t->yaw)};
+  // The baselines keep their matchers' own answers: a common finish would make them all one matcher.
+  if (params_.method == LocalizerMethod::proposed)
+    z = refine_curb_match(features, z, local.index, local.tangents, params_.curb_noise);
   const CurbMatchQuality q = curb_match_quality(features, z, local.index, local.tangents, params_.curb_noise);
   e.curb_observation = z;
   e.curb_inlier_ratio = q.inlier_ratio;
@@ -651,20 +654,22 @@ ApsParams Localizer::aps_window(const Pose2d& prior) const {
 
 // 3.3: the APS position into KF2, if it passes the innovation gate; only along the road when the curbs
 // were matched in this scan (see aps_longitudinal_only_with_curbs).
-void Localizer::fuse_intensity(const ApsResult& aps, double redundancy, LocalizerEstimate& e) {
+void Localizer::fuse_intensity(const ApsResult& aps, const IntensityGrid& grid, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::fusion));
   const Pose2d prior = filter_->pose();
   const Eigen::Vector2d innovation = aps.position - xy(prior);
   // APS's claim, widened by S's redundancy (IntensityGrid::redundancy), then scaled by what its
-  // innovations have shown of it so far (innovation_scale.hpp).
-  const Eigen::Matrix2d claimed = aps.covariance * params_.aps_covariance_scale * redundancy;
-  const Eigen::Matrix2d R = scaled_along_across(claimed, prior.yaw, aps_scale_.scale());
+  // innovations have shown of it so far (innovation_scale.hpp), on straights or in bends.
+  const Eigen::Matrix2d claimed = aps.covariance * params_.aps_covariance_scale * grid.redundancy;
+  InnovationScale& scale = grid.turning ? aps_scale_turning_ : aps_scale_straight_;
+  const Eigen::Matrix2d R = scaled_along_across(claimed, prior.yaw, scale.scale());
   // APS matched at the prior's heading: a heading error moves its answer by yaw_coupling per radian,
   // so the observation is z = p + J (psi_prior - psi) and its gate counts the heading's doubt; in a
   // bend or with paint on one side of the car the update then also corrects the heading.
   const Eigen::Vector2d& J = aps.yaw_coupling;
   const Eigen::Matrix<double, 2, 3> H = intensity_observation_matrix(J);
-  const Eigen::Matrix2d S = H * filter_->covariance() * H.transpose() + R;
+  const Eigen::Matrix2d HPH = H * filter_->covariance() * H.transpose();  // the prior's doubt of z
+  const Eigen::Matrix2d S = HPH + R;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_intensity, intensity_rejections_)) {
     e.health |= kIntensityMatchRejected;
     disagree(innovation);
@@ -699,13 +704,12 @@ void Localizer::fuse_intensity(const ApsResult& aps, double redundancy, Localize
   if (along || across) {
     const Eigen::Matrix2d to_vehicle = Eigen::Rotation2Dd(-prior.yaw).toRotationMatrix();
     const Eigen::Vector2d nu = to_vehicle * innovation;
-    const Eigen::Vector2d prior_variance = (to_vehicle * P * to_vehicle.transpose()).diagonal();
+    const Eigen::Vector2d prior_variance = (to_vehicle * HPH * to_vehicle.transpose()).diagonal();
     const double unused = std::numeric_limits<double>::quiet_NaN();
     const Eigen::Vector2d claimed_variance = (to_vehicle * claimed * to_vehicle.transpose()).diagonal();
     // Learnt while tracking only: lost, the filter's own variance is not yet to be believed.
     if (!lost_.lost())
-      aps_scale_.add(nu, prior_variance,
-                     {along ? claimed_variance.x() : unused, across ? claimed_variance.y() : unused});
+      scale.add(nu, prior_variance, {along ? claimed_variance.x() : unused, across ? claimed_variance.y() : unused});
     agree(prior, along, across);
   }
 }

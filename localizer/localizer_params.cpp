@@ -261,6 +261,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("min_sigma_m", p.curb_noise.min_sigma_m, 0.0, 10.0)
       .number("min_sigma_yaw_rad", p.curb_noise.min_sigma_yaw_rad, 0.0, 1.0)
       .number("unconstrained_sigma_m", p.curb_noise.unconstrained_sigma_m, 1.0, 1e6)
+      .integer("refine_iterations", p.curb_noise.refine_iterations, 0, 100)
       .done();
   YamlMap(y, top["gps_noise"], "gps_noise")
       .number("min_sigma_m", p.gps_noise.min_sigma_m, 0.0, 100.0)

@@ -110,6 +110,21 @@ TEST(IntensityAccumulator, ABendDropsTheOlderFrames) {
   EXPECT_EQ(acc.points(), 2 * points.size());
 }
 
+TEST(IntensityAccumulator, SSaysWhenTheLastScanTurnedBeyondTheLimit) {
+  const IntensityGridParams p = grid_params();
+  const double limit = 0.5 * 3.14159265358979 / 180;
+  IntensityAccumulator acc(5, limit);
+  std::vector<Eigen::Vector2d> points;
+  std::vector<double> intensities;
+  scan({0, 0}, 0.0, {5.05}, points, intensities);
+  acc.add(points, intensities, {0.5, 0.0, 0.9 * limit});
+  EXPECT_FALSE(acc.grid({}, p, kMinCount).turning);
+  acc.add(points, intensities, {0.5, 0.0, -1.1 * limit});  // a right turn counts as well
+  EXPECT_TRUE(acc.grid({}, p, kMinCount).turning);
+  acc.add(points, intensities, {0.5, 0.0, 0.0});
+  EXPECT_FALSE(acc.grid({}, p, kMinCount).turning);
+}
+
 TEST(IntensityAccumulator, AnEmptyScanKeepsTheOlderFramesInPlace) {
   const IntensityGridParams p = grid_params();
   IntensityAccumulator acc(3, 1.0);
