@@ -77,34 +77,35 @@ double along_sigma(const Eigen::Matrix3d& covariance, double yaw) {
 
 }  // namespace
 
-Pose2d refine_curb_match(const std::vector<Eigen::Vector2d>& curbs_vehicle, Pose2d pose, const MapIndex& map,
-                         const std::vector<Eigen::Vector2d>& map_tangents, const CurbMatchNoise& noise) {
-  for (int k = 0; k < noise.refine_iterations; ++k) {
+CurbMatchQuality finish_curb_match(const std::vector<Eigen::Vector2d>& curbs_vehicle, Pose2d pose, const MapIndex& map,
+                                   const std::vector<Eigen::Vector2d>& map_tangents, const CurbMatchNoise& noise) {
+  for (int k = 0;; ++k) {
     const PointToLine sums = point_to_line(curbs_vehicle, pose, map, map_tangents, noise.inlier_distance_m);
-    if (sums.inliers_vehicle.empty()) break;
+    CurbMatchQuality q;
+    q.pose = pose;
+    q.inliers = sums.inliers_vehicle.size();
+    q.inlier_ratio = curbs_vehicle.empty() ? 0.0 : double(q.inliers) / double(curbs_vehicle.size());
+    q.covariance = match_covariance(sums, noise);
     // Where the curbs leave the position along the road open (a straight), ICP has converged on what
     // they do fix, and a step would only follow their noise along it.
-    if (k == 0 && along_sigma(match_covariance(sums, noise), pose.yaw) > noise.inlier_distance_m) break;
+    if (k == noise.refine_iterations || q.inliers == 0 ||
+        (k == 0 && along_sigma(q.covariance, pose.yaw) > noise.inlier_distance_m))
+      return q;
     // Residuals in units of the detector's noise, so that the weak prior weighs as in the covariance.
     const double variance = noise.min_point_sigma_m * noise.min_point_sigma_m;
     const Eigen::Vector3d step =
         -with_weak_prior(sums.information / variance, noise).ldlt().solve(sums.gradient / variance);
     // Beyond the inlier distance the nearest lines are other lines: the linearisation no longer holds.
-    if (!step.allFinite() || step.head<2>().norm() > noise.inlier_distance_m) break;
+    if (!step.allFinite() || step.head<2>().norm() > noise.inlier_distance_m) return q;
     pose = {pose.x + step.x(), pose.y + step.y(), wrap_angle(pose.yaw + step.z())};
   }
-  return pose;
 }
 
 CurbMatchQuality curb_match_quality(const std::vector<Eigen::Vector2d>& curbs_vehicle, const Pose2d& pose,
                                     const MapIndex& map, const std::vector<Eigen::Vector2d>& map_tangents,
-                                    const CurbMatchNoise& noise) {
-  CurbMatchQuality q;
-  const PointToLine sums = point_to_line(curbs_vehicle, pose, map, map_tangents, noise.inlier_distance_m);
-  q.inliers = sums.inliers_vehicle.size();
-  q.inlier_ratio = curbs_vehicle.empty() ? 0.0 : double(q.inliers) / double(curbs_vehicle.size());
-  q.covariance = match_covariance(sums, noise);
-  return q;
+                                    CurbMatchNoise noise) {
+  noise.refine_iterations = 0;
+  return finish_curb_match(curbs_vehicle, pose, map, map_tangents, noise);
 }
 
 }  // namespace lidarloop

@@ -32,33 +32,34 @@ struct CurbMatchNoise {
   // A direction without any curb information gets this standard deviation rather than an infinite one
   // (an observation with a huge variance leaves the filter's estimate there as it was).
   double unconstrained_sigma_m = 100.0;
-  // Gauss-Newton steps on the point-to-line residuals after probabilistic ICP (refine_curb_match; the
+  // Gauss-Newton steps on the point-to-line residuals after probabilistic ICP (finish_curb_match; the
   // proposed method only); 0: none.
   int refine_iterations = 3;
 };
 
 struct CurbMatchQuality {
+  Pose2d pose;                                               // the matched pose this is the quality of
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // of (x, y, psi), local frame
   size_t inliers = 0;
   double inlier_ratio = 0;
 };
 
-// ICP's answer finished by Gauss-Newton on the same point-to-line residuals whose information
-// curb_match_quality's covariance is. Point-to-point ICP crawls along a direction the curbs barely
-// constrain (in a bend, the arc turned about its centre ties the position along the road to the
-// heading), so its answer stays near the prior there, and the covariance of a converged match then
-// counted the prior twice: at a bend's exit the curbs claimed 0.11 m along the road while 0.2-0.45 m off
-// (closed_loop_campus at b9e57ab). Only where the curbs place the car along the road to within the
-// inlier distance (a bend's entry and exit, a corner): elsewhere ICP has converged on what they fix, and
-// steps followed their noise along a straight by a metre. A step that would move the car beyond the
-// inlier distance ends it.
-Pose2d refine_curb_match(const std::vector<Eigen::Vector2d>& curbs_vehicle, Pose2d pose, const MapIndex& map,
-                         const std::vector<Eigen::Vector2d>& map_tangents, const CurbMatchNoise& noise);
+// ICP's answer `pose` finished by Gauss-Newton on the same point-to-line residuals whose information the
+// covariance is, and the quality at the pose it ends at (its `pose`). Point-to-point ICP crawls along a
+// direction the curbs barely constrain (in a bend, the arc turned about its centre ties the position
+// along the road to the heading), so its answer stays near the prior there, and the covariance of a
+// converged match then counted the prior twice: at a bend's exit the curbs claimed 0.11 m along the
+// road while 0.2-0.45 m off (closed_loop_campus at b9e57ab). Only where the curbs place the car along
+// the road to within the inlier distance (a bend's entry and exit, a corner): elsewhere ICP has
+// converged on what they fix, and steps followed their noise along a straight by a metre. A step that
+// would move the car beyond the inlier distance ends it.
+CurbMatchQuality finish_curb_match(const std::vector<Eigen::Vector2d>& curbs_vehicle, Pose2d pose, const MapIndex& map,
+                                   const std::vector<Eigen::Vector2d>& map_tangents, const CurbMatchNoise& noise);
 
-// curbs_vehicle: the curb features in the vehicle frame; pose: the matched pose. The map's points and
-// unit tangents (CurbLayer::tangents) index as `map`'s points.
+// The quality of the match at `pose` as it is (no steps). curbs_vehicle: the curb features in the vehicle
+// frame. The map's points and unit tangents (CurbLayer::tangents) index as `map`'s points.
 CurbMatchQuality curb_match_quality(const std::vector<Eigen::Vector2d>& curbs_vehicle, const Pose2d& pose,
                                     const MapIndex& map, const std::vector<Eigen::Vector2d>& map_tangents,
-                                    const CurbMatchNoise& noise);
+                                    CurbMatchNoise noise);
 
 }  // namespace lidarloop

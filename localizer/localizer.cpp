@@ -492,11 +492,13 @@ std::optional<Localizer::PoseObservation> Localizer::match_curbs(const std::vect
     return std::nullopt;
   }
   const Eigen::Vector2d corrected_xy = t->apply(xy(prior));
-  Pose2d z{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t->yaw)};
+  const Pose2d matched{corrected_xy.x(), corrected_xy.y(), wrap_angle(prior.yaw + t->yaw)};
   // The baselines keep their matchers' own answers: a common finish would make them all one matcher.
-  if (params_.method == LocalizerMethod::proposed)
-    z = refine_curb_match(features, z, local.index, local.tangents, params_.curb_noise);
-  const CurbMatchQuality q = curb_match_quality(features, z, local.index, local.tangents, params_.curb_noise);
+  const CurbMatchQuality q =
+      params_.method == LocalizerMethod::proposed
+          ? finish_curb_match(features, matched, local.index, local.tangents, params_.curb_noise)
+          : curb_match_quality(features, matched, local.index, local.tangents, params_.curb_noise);
+  const Pose2d& z = q.pose;
   e.curb_observation = z;
   e.curb_inlier_ratio = q.inlier_ratio;
   if (q.inlier_ratio < params_.health.min_inlier_ratio) {

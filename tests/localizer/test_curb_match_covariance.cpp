@@ -78,7 +78,7 @@ TEST(CurbMatchCovariance, ABendLeavesItsTurnAboutTheCentreFree) {
   EXPECT_EQ(q.inliers, seen_from(truth, map, 20.0).size());
 }
 
-TEST(CurbMatchCovariance, RefineRecoversAKnownOffsetWhereTheBendMeetsTheStraight) {
+TEST(CurbMatchCovariance, FinishRecoversAKnownOffsetWhereTheBendMeetsTheStraight) {
   const CurbMap map = bend_into_straight();
   const MapIndex index(map.points);
   const Pose2d truth = on_bend(-5 * kDeg);  // 4 m before the straight: both in view
@@ -86,7 +86,7 @@ TEST(CurbMatchCovariance, RefineRecoversAKnownOffsetWhereTheBendMeetsTheStraight
   // Off along the bend's weak direction (0.4 m along, 0.5 deg) and 5 cm across, as ICP leaves it.
   Pose2d start = turned_about_centre(truth, 0.4 / kRadius);
   start.x += 0.05;
-  const Pose2d refined = refine_curb_match(seen, start, index, map.tangents, {});
+  const Pose2d refined = finish_curb_match(seen, start, index, map.tangents, {}).pose;
   EXPECT_LT(position_error(refined, truth), 0.005);
   EXPECT_LT(std::abs(wrap_angle(refined.yaw - truth.yaw)), 0.01 * kDeg);
   // And the covariance there pins the position along the road too.
@@ -95,7 +95,7 @@ TEST(CurbMatchCovariance, RefineRecoversAKnownOffsetWhereTheBendMeetsTheStraight
   EXPECT_LT(std::sqrt(forward.dot(q.covariance.topLeftCorner<2, 2>() * forward)), 0.05);
 }
 
-TEST(CurbMatchCovariance, RefineLeavesAPoseTheCurbsCannotPlaceAlongTheRoad) {
+TEST(CurbMatchCovariance, FinishLeavesAPoseTheCurbsCannotPlaceAlongTheRoad) {
   // Mid-bend the arcs leave the turn about their centre free; on a straight, the position along it.
   // ICP has converged on what they do fix; a finish would only follow their noise along the rest.
   const CurbMap map = bend_into_straight();
@@ -103,27 +103,27 @@ TEST(CurbMatchCovariance, RefineLeavesAPoseTheCurbsCannotPlaceAlongTheRoad) {
   const Pose2d truth = on_bend(-std::numbers::pi / 4);
   Pose2d start = turned_about_centre(truth, 0.4 / kRadius);
   start.x += 0.05;
-  Pose2d refined = refine_curb_match(seen_from(truth, map, 20.0), start, index, map.tangents, {});
+  Pose2d refined = finish_curb_match(seen_from(truth, map, 20.0), start, index, map.tangents, {}).pose;
   EXPECT_EQ(refined.x, start.x);
   EXPECT_EQ(refined.yaw, start.yaw);
   const Pose2d on_straight{kRadius, 40.0, std::numbers::pi / 2};
   start = {kRadius + 0.05, 40.5, on_straight.yaw};
-  refined = refine_curb_match(seen_from(on_straight, map, 15.0), start, index, map.tangents, {});
+  refined = finish_curb_match(seen_from(on_straight, map, 15.0), start, index, map.tangents, {}).pose;
   EXPECT_EQ(refined.y, start.y);
 }
 
-TEST(CurbMatchCovariance, RefineLeavesThePoseWithoutInliersOrIterations) {
+TEST(CurbMatchCovariance, FinishLeavesThePoseWithoutInliersOrIterations) {
   const CurbMap map = bend_into_straight();
   const MapIndex index(map.points);
   const Pose2d truth = on_bend(-5 * kDeg);
   Pose2d start = truth;
   start.x += 2.5;  // across the road: the features land 1.5 m and 6.5 m from the curbs
-  const Pose2d refined = refine_curb_match(seen_from(truth, map, 20.0), start, index, map.tangents, {});
+  const Pose2d refined = finish_curb_match(seen_from(truth, map, 20.0), start, index, map.tangents, {}).pose;
   EXPECT_EQ(refined.x, start.x);
   EXPECT_EQ(refined.y, start.y);
   CurbMatchNoise none;
   none.refine_iterations = 0;
-  const Pose2d unchanged = refine_curb_match(seen_from(truth, map, 20.0), start, index, map.tangents, none);
+  const Pose2d unchanged = finish_curb_match(seen_from(truth, map, 20.0), start, index, map.tangents, none).pose;
   EXPECT_EQ(unchanged.x, start.x);
   EXPECT_EQ(unchanged.yaw, start.yaw);
 }
