@@ -5,8 +5,7 @@
 #include <set>
 
 #include <Eigen/Geometry>
-#include <nanoflann.hpp>
-
+#include "localizer/map_index.hpp"
 #include "localizer/probabilistic_icp.hpp"
 
 namespace lidarloop {
@@ -36,32 +35,19 @@ std::vector<Eigen::Vector2d> CurbAccumulator::curbs() const {
   return all;
 }
 
-namespace {
-struct Cloud2d {  // nanoflann dataset interface
-  const std::vector<Eigen::Vector2d>& points;
-  size_t kdtree_get_point_count() const { return points.size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return points[i][int(dim)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-};
-}  // namespace
-
 std::vector<Eigen::Vector2d> reject_near_obstacles(const std::vector<Eigen::Vector2d>& curbs,
                                                    const std::vector<Eigen::Vector2d>& obstacles, double distance) {
-  if (obstacles.empty()) return curbs;
-  const Cloud2d cloud{obstacles};
-  nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud2d>, Cloud2d, 2> tree(
-      2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-  tree.buildIndex();
+  std::vector<Eigen::Vector2d> finite;
+  finite.reserve(obstacles.size());
+  for (const auto& o : obstacles)
+    if (o.allFinite()) finite.push_back(o);
+  if (finite.empty() || !(distance > 0)) return curbs;
+  // Buckets only: between parked rows there are thousands of obstacle points a scan against a few
+  // hundred curbs, and a KD-tree over them cost more than the questions (MapIndex::Queries).
+  const MapIndex index(std::move(finite), distance, MapIndex::Queries::within_only);
   std::vector<Eigen::Vector2d> kept;
-  for (const auto& c : curbs) {
-    uint32_t index = 0;
-    double d2 = 0;
-    tree.knnSearch(c.data(), 1, &index, &d2);
-    if (d2 > distance * distance) kept.push_back(c);
-  }
+  for (const auto& c : curbs)
+    if (index.nearest_within(c, distance).first == SIZE_MAX) kept.push_back(c);
   return kept;
 }
 

@@ -39,7 +39,8 @@ class CurbAccumulator {
   std::deque<Eigen::Vector2d> origins_;               // vehicle positions of those frames, newest first
 };
 
-// Curbs within d_o of any obstacle point are the feet of cars and people, not curbs (KD-tree search).
+// Curbs within d_o of any obstacle point are the feet of cars and people, not curbs. Non-finite
+// obstacle points are ignored; d_o <= 0 keeps every curb.
 std::vector<Eigen::Vector2d> reject_near_obstacles(const std::vector<Eigen::Vector2d>& curbs,
                                                    const std::vector<Eigen::Vector2d>& obstacles, double distance);
 

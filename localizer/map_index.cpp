@@ -19,14 +19,14 @@ constexpr double kMaxBucketsPerPoint = 4.0;
 constexpr double kMinBucketBudget = 4096;
 }  // namespace
 
-MapIndex::MapIndex(std::vector<Eigen::Vector2d> points, double bucket_m) : points_(std::move(points)) {
+MapIndex::MapIndex(std::vector<Eigen::Vector2d> points, double bucket_m, Queries queries) : points_(std::move(points)) {
   if (!(bucket_m > 0) || !std::isfinite(bucket_m))
     throw std::invalid_argument("MapIndex: bucket size must be a positive number");
   for (const auto& p : points_)
     if (!p.allFinite()) throw std::invalid_argument("MapIndex: map points must be finite");
   // nanoflann cannot build over zero points; an empty map answers every query with "nothing".
   if (points_.empty()) return;
-  tree_ = std::make_unique<Tree>(&points_);
+  if (queries == Queries::any) tree_ = std::make_unique<Tree>(&points_);
 
   Buckets& b = buckets_;
   Eigen::Vector2d lo = points_[0], hi = points_[0];
@@ -73,7 +73,8 @@ MapIndex& MapIndex::operator=(MapIndex&& other) noexcept {
 }
 
 std::pair<size_t, double> MapIndex::nearest(const Eigen::Vector2d& p) const {
-  if (!tree_) return {SIZE_MAX, std::numeric_limits<double>::infinity()};
+  if (points_.empty()) return {SIZE_MAX, std::numeric_limits<double>::infinity()};
+  if (!tree_) throw std::logic_error("MapIndex::nearest: the index was built for nearest_within only");
   uint32_t index = 0;
   double squared = 0;
   const double query[2] = {p.x(), p.y()};
@@ -83,7 +84,7 @@ std::pair<size_t, double> MapIndex::nearest(const Eigen::Vector2d& p) const {
 
 std::pair<size_t, double> MapIndex::nearest_within(const Eigen::Vector2d& p, double radius) const {
   constexpr std::pair<size_t, double> none{SIZE_MAX, std::numeric_limits<double>::infinity()};
-  if (!tree_ || !p.allFinite() || !(radius >= 0)) return none;
+  if (points_.empty() || !p.allFinite() || !(radius >= 0)) return none;
   const Buckets& b = buckets_;
   if (radius > b.size) {  // the circle reaches past the neighbouring buckets: the tree is cheaper
     const auto found = nearest(p);

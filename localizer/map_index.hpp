@@ -23,17 +23,24 @@ class MapIndex {
  public:
   static constexpr double kDefaultBucketM = 1.0;  // the paper's d_g: global ICP's gate in one ring
 
-  explicit MapIndex(std::vector<Eigen::Vector2d> points, double bucket_m = kDefaultBucketM);
+  // What the index will be asked: a KD-tree for nearest() is built only for `any`. `within_only` indexes
+  // thousands of points a scan (a parked car's returns) to ask nearest_within() up to bucket_m, where
+  // building the tree cost more than all the questions.
+  enum class Queries { any, within_only };
+  explicit MapIndex(std::vector<Eigen::Vector2d> points, double bucket_m = kDefaultBucketM,
+                    Queries queries = Queries::any);
   ~MapIndex();
   MapIndex(MapIndex&&) noexcept;
   MapIndex& operator=(MapIndex&&) noexcept;
 
   const std::vector<Eigen::Vector2d>& points() const { return points_; }
   bool empty() const { return points_.empty(); }
-  // Index of and Euclidean distance to the nearest map point; (SIZE_MAX, inf) for an empty map.
+  // Index of and Euclidean distance to the nearest map point; (SIZE_MAX, inf) for an empty map. Throws
+  // std::logic_error for an index built `within_only`.
   std::pair<size_t, double> nearest(const Eigen::Vector2d& p) const;
   // The nearest map point if it is within `radius` (the same point nearest() finds, ties aside);
-  // otherwise, or for a non-finite p, (SIZE_MAX, inf).
+  // otherwise, or for a non-finite p, (SIZE_MAX, inf). An index built `within_only` throws
+  // std::logic_error for a radius beyond its buckets (at least its bucket_m).
   std::pair<size_t, double> nearest_within(const Eigen::Vector2d& p, double radius) const;
 
  private:

@@ -50,6 +50,27 @@ TEST(CurbFeatures, CurbsNextToObstaclesAreRejected) {
   EXPECT_EQ(kept[1], Eigen::Vector2d(15, -4));
 }
 
+TEST(CurbFeatures, ObstacleRejectionAgreesWithTheDefinitionAndIgnoresNonFinitePoints) {
+  // A thousand obstacle points against curbs along two lines: about a third of the curbs stay.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> along(-30, 30), across(-6, 6);
+  std::vector<Eigen::Vector2d> curbs, obstacles;
+  for (int k = 0; k < 400; ++k) curbs.push_back({along(rng), k % 2 ? -4.0 : 4.0});
+  for (int k = 0; k < 1000; ++k) obstacles.push_back({along(rng), across(rng)});
+  obstacles.push_back({std::nan(""), 0.0});
+  const auto kept = reject_near_obstacles(curbs, obstacles, 0.5);
+  std::vector<Eigen::Vector2d> expected;
+  for (const auto& c : curbs) {
+    bool near = false;
+    for (const auto& o : obstacles) near |= o.allFinite() && (c - o).norm() <= 0.5;
+    if (!near) expected.push_back(c);
+  }
+  EXPECT_EQ(kept, expected);
+  EXPECT_GT(expected.size(), 0u);
+  EXPECT_LT(expected.size(), curbs.size());
+  EXPECT_EQ(reject_near_obstacles(curbs, obstacles, 0.0), curbs);  // d_o = 0: keep them all
+}
+
 TEST(CurbFeatures, TheBeamModelKeepsTheNearestCurbInEachBeam) {
   // Two rings of "curbs" around the vehicle: the inner one at 5 m hides the outer one at 10 m.
   std::vector<Eigen::Vector2d> curbs;

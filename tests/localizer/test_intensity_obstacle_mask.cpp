@@ -1,5 +1,7 @@
 // Ground points near obstacles stay out of S (IntensityGridParams::obstacle_distance): which cells of S
 // lie within the distance of an obstacle point, by their centres.
+#include <random>
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -36,6 +38,27 @@ TEST(IntensityObstacleMask, CellsWithinTheDistanceOfAnObstacleAreMarked) {
   int marked = 0;
   for (char m : mask) marked += m;
   EXPECT_EQ(marked, 21);
+}
+
+TEST(IntensityObstacleMask, MarksExactlyTheCellsWhoseCentresAreWithinTheDistance) {
+  // Random obstacles, some off the grid, against the definition cell by cell.
+  for (double distance : {0.5, 0.33, 1.0}) {
+    const IntensityGridParams p = params(distance);
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> coordinate(-10.6, 10.6);
+    std::vector<Eigen::Vector2d> obstacles;
+    for (int k = 0; k < 300; ++k) obstacles.push_back({coordinate(rng), coordinate(rng)});
+    const std::vector<char> mask = cells_near_obstacles(obstacles, p);
+    for (int r = 0; r < p.height_cells; ++r)
+      for (int c = 0; c < p.width_cells; ++c) {
+        const Eigen::Vector2d centre((c + 0.5 - 0.5 * p.width_cells) * p.cell_m,
+                                     (r + 0.5 - 0.5 * p.height_cells) * p.cell_m);
+        bool expected = false;
+        for (const Eigen::Vector2d& o : obstacles) expected |= (centre - o).squaredNorm() <= distance * distance;
+        ASSERT_EQ(mask[size_t(r) * size_t(p.width_cells) + size_t(c)] != 0, expected)
+            << "cell " << c << ", " << r << " at distance " << distance;
+      }
+  }
 }
 
 TEST(IntensityObstacleMask, AnObstacleJustOffTheGridStillMarksTheEdge) {
