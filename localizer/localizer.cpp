@@ -695,7 +695,8 @@ void Localizer::fuse_intensity(const ApsResult& aps, const IntensityGrid& grid, 
     return aps.spread_ratio[axis] <= params_.aps_max_spread_ratio &&
            (!grown || u.dot(aps.covariance * u) <= prior_variance);
   };
-  const bool along = informative(0, forward, params_.aps.longitudinal_range_m);
+  const bool along =
+      confirmed_along(informative(0, forward, params_.aps.longitudinal_range_m), forward.dot(innovation), forward);
   const bool across = informative(1, left, params_.aps.lateral_range_m) && !curbs_hold_lateral;
   if (along && across)
     filter_->update_intensity(aps.position, R, J);  // KF2
@@ -714,6 +715,25 @@ void Localizer::fuse_intensity(const ApsResult& aps, const IntensityGrid& grid, 
       scale.add(nu, prior_variance, {along ? claimed_variance.x() : unused, across ? claimed_variance.y() : unused});
     agree(prior, along, across);
   }
+}
+
+// In a window grown to the prior's doubt (a cold start, a kidnap) APS searches as the relocalization
+// does, and dashed lines repeat along the road: a single scan's S put the car one dash period off with
+// full confidence (dynamic_campus under harsh, seed 1: 9.4 m for the whole run). Its position along the
+// road is taken, as the relocalization's places are, only when the next scan's match agrees with it
+// (within relocalization.confirm_distance_m); held back meanwhile. In the paper's window: at once.
+bool Localizer::confirmed_along(bool informative, double innovation_along, const Eigen::Vector2d& forward) {
+  const double spread = std::sqrt(forward.dot(filter_->covariance().topLeftCorner<2, 2>() * forward));
+  if (!informative || params_.aps_window_sigmas * spread <= params_.aps.longitudinal_range_m) {
+    held_along_.reset();
+    return informative;
+  }
+  if (held_along_ && std::abs(innovation_along - *held_along_) <= params_.relocalization.confirm_distance_m) {
+    held_along_.reset();
+    return true;
+  }
+  held_along_ = innovation_along;
+  return false;
 }
 
 double Localizer::position_sigma() const {
