@@ -849,11 +849,19 @@ void Localizer::move_to(const Relocation& found) {
 }
 
 // Who jumped, once the map has placed the car? If it is about where the filter had it before it was
-// lost while the GPS had stepped, the GPS did: its fixes are rejected until they step back.
+// lost while the GPS had stepped, the GPS did. A step away from the filter is a fault: the fixes are
+// rejected until they step back. A step towards it ends one the detector had not caught (a jump that
+// came before its level was learnt, at a cold start): the new level is learnt instead. Rejected, such
+// a GPS waited for a level it would never return to (gps_degraded: GPS rejected for the last 70 s).
 void Localizer::judge_gps_jump(const Pose2d& placed) {
-  if (gps_stepped_ && trusted_ && last_gps_step_ &&
-      (xy(placed) - xy(trusted_->pose)).norm() < 0.5 * last_gps_step_->norm())
-    gps_fault_level_ = gps_steps_.level();
+  const std::optional<Eigen::Vector2d>& before = gps_steps_.level();
+  if (gps_stepped_ && trusted_ && last_gps_step_ && before &&
+      (xy(placed) - xy(trusted_->pose)).norm() < 0.5 * last_gps_step_->norm()) {
+    if ((*before + *last_gps_step_).norm() > before->norm())
+      gps_fault_level_ = before;
+    else
+      gps_steps_.restart();
+  }
   gps_stepped_ = false;
 }
 

@@ -100,7 +100,8 @@ LocalizerParams test_params() {
 struct DriveOptions {
   double duration_s = 6;
   Eigen::Vector2d gps_bias{-1.5, 1.2};  // m, east and north: the known offset to remove
-  double lateral = -2.0;                // the car's true y (right-hand lane)
+  std::function<Eigen::Vector2d(int64_t)> gps_jump = [](int64_t) { return Eigen::Vector2d::Zero(); };  // added
+  double lateral = -2.0;  // the car's true y (right-hand lane)
   int azimuth_steps = 900;
   std::function<bool(int64_t)> gps_up = [](int64_t) { return true; };
   std::function<bool(int64_t)> can_up = [](int64_t) { return true; };
@@ -126,7 +127,7 @@ std::vector<std::pair<LocalizerEstimate, Pose2d>> drive(Localizer& localizer, co
       GpsFix g;
       g.stamp_ns = t;
       g.status = GpsStatus::fix;
-      const Geodetic ll = frame.to_geodetic(Eigen::Vector2d(truth.x, truth.y) + o.gps_bias);
+      const Geodetic ll = frame.to_geodetic(Eigen::Vector2d(truth.x, truth.y) + o.gps_bias + o.gps_jump(t));
       g.lat_deg = ll.lat_deg, g.lon_deg = ll.lon_deg;
       g.heading_rad = 0.02;
       g.position_covariance[0] = g.position_covariance[4] = 4.0;
@@ -357,6 +358,39 @@ TEST(LocalizerParams, ReadsOverridesAndRejectsUnknownKeys) {
 // A fix is the antenna's position. Driving straight at 60 deg with exact fixes of an antenna 1.5 m
 // ahead and 0.3 m left of the rear axle: configured with that lever arm, KF1's rear axle is the true
 // one to within 1 cm; configured without it, the estimate is off by the arm (the test can fail).
+// A multipath jump of 4 m along the road, once the GPS's level is known (from 3 s to 5 s), or already
+// there when the drive starts (until 3 s). Either way the map holds the car where it is.
+bool gps_rejected_after(const std::vector<std::pair<LocalizerEstimate, Pose2d>>& run, double t_s) {
+  for (const auto& [e, truth] : run)
+    if (e.stamp_ns * 1e-9 > t_s && (e.health & kGpsRejected)) return true;
+  return false;
+}
+
+TEST(LocalizerGps, AJumpAwayFromTheMapsPoseIsRejectedUntilItStepsBack) {
+  Localizer localizer(shared_map(), test_params());
+  DriveOptions o;
+  o.duration_s = 7;
+  o.gps_jump = [](int64_t t) { return Eigen::Vector2d(t >= 3'000'000'000 && t < 5'000'000'000 ? 4.0 : 0.0, 0.0); };
+  const auto run = drive(localizer, o);
+  EXPECT_TRUE(gps_rejected_after(run, 3.5));
+  EXPECT_FALSE(gps_rejected_after(run, 5.5));
+  for (const auto& [e, truth] : run) {
+    if (e.stamp_ns > 3'000'000'000) {
+      EXPECT_LT(std::abs(e.pose.x - truth.x), 0.5) << e.stamp_ns;
+    }
+  }
+}
+
+TEST(LocalizerGps, AJumpThatEndsBeforeItsLevelWasKnownIsNotRejectedForever) {
+  // The GPS starts 4 m off and steps back to its usual bias at 3 s: a step towards the map's pose.
+  Localizer localizer(shared_map(), test_params());
+  DriveOptions o;
+  o.duration_s = 7;
+  o.gps_jump = [](int64_t t) { return Eigen::Vector2d(t < 3'000'000'000 ? 4.0 : 0.0, 0.0); };
+  const auto run = drive(localizer, o);
+  EXPECT_FALSE(gps_rejected_after(run, 4.0));
+}
+
 TEST(LocalizerGps, TheConfiguredLeverArmIsTakenOffTheFixes) {
   HdMap map = synthetic_map();
   const LocalFrame frame(kOrigin);
