@@ -81,22 +81,29 @@ CurbMatchQuality finish_curb_match(const std::vector<Eigen::Vector2d>& curbs_veh
                                    const std::vector<Eigen::Vector2d>& map_tangents, const CurbMatchNoise& noise) {
   for (int k = 0;; ++k) {
     const PointToLine sums = point_to_line(curbs_vehicle, pose, map, map_tangents, noise.inlier_distance_m);
-    CurbMatchQuality q;
-    q.pose = pose;
-    q.inliers = sums.inliers_vehicle.size();
-    q.inlier_ratio = curbs_vehicle.empty() ? 0.0 : double(q.inliers) / double(curbs_vehicle.size());
-    q.covariance = match_covariance(sums, noise);
+    // The covariance (a set over the features) only where it is used: to decide on the first step, and
+    // for the pose the finish ends at.
+    auto quality = [&] {
+      CurbMatchQuality q;
+      q.pose = pose;
+      q.inliers = sums.inliers_vehicle.size();
+      q.inlier_ratio = curbs_vehicle.empty() ? 0.0 : double(q.inliers) / double(curbs_vehicle.size());
+      q.covariance = match_covariance(sums, noise);
+      return q;
+    };
+    if (k == noise.refine_iterations || sums.inliers_vehicle.empty()) return quality();
     // Where the curbs leave the position along the road open (a straight), ICP has converged on what
     // they do fix, and a step would only follow their noise along it.
-    if (k == noise.refine_iterations || q.inliers == 0 ||
-        (k == 0 && along_sigma(q.covariance, pose.yaw) > noise.inlier_distance_m))
-      return q;
+    if (k == 0) {
+      const CurbMatchQuality q = quality();
+      if (along_sigma(q.covariance, pose.yaw) > noise.inlier_distance_m) return q;
+    }
     // Residuals in units of the detector's noise, so that the weak prior weighs as in the covariance.
     const double variance = noise.min_point_sigma_m * noise.min_point_sigma_m;
     const Eigen::Vector3d step =
         -with_weak_prior(sums.information / variance, noise).ldlt().solve(sums.gradient / variance);
     // Beyond the inlier distance the nearest lines are other lines: the linearisation no longer holds.
-    if (!step.allFinite() || step.head<2>().norm() > noise.inlier_distance_m) return q;
+    if (!step.allFinite() || step.head<2>().norm() > noise.inlier_distance_m) return quality();
     pose = {pose.x + step.x(), pose.y + step.y(), wrap_angle(pose.yaw + step.z())};
   }
 }

@@ -689,14 +689,17 @@ void Localizer::fuse_intensity(const ApsResult& aps, const IntensityGrid& grid, 
       params_.aps_longitudinal_only_with_curbs && e.curb_observation && !(e.health & kCurbMatchRejected);
   const Eigen::Vector2d forward(std::cos(prior.yaw), std::sin(prior.yaw)), left(-forward.y(), forward.x());
   const Eigen::Matrix2d P = filter_->covariance().topLeftCorner<2, 2>();
-  auto informative = [&](int axis, const Eigen::Vector2d& u, double paper_range) {
-    const double prior_variance = u.dot(P * u);
-    const bool grown = params_.aps_window_sigmas * std::sqrt(prior_variance) > paper_range;
-    return aps.spread_ratio[axis] <= params_.aps_max_spread_ratio &&
-           (!grown || u.dot(aps.covariance * u) <= prior_variance);
+  // The window on this axis grown beyond the paper's to the prior's spread (aps_window).
+  auto grown = [&](const Eigen::Vector2d& u, double paper_range) {
+    return params_.aps_window_sigmas * std::sqrt(u.dot(P * u)) > paper_range;
   };
+  auto informative = [&](int axis, const Eigen::Vector2d& u, double paper_range) {
+    return aps.spread_ratio[axis] <= params_.aps_max_spread_ratio &&
+           (!grown(u, paper_range) || u.dot(aps.covariance * u) <= u.dot(P * u));
+  };
+  const double along_range = params_.aps.longitudinal_range_m;
   const bool along =
-      confirmed_along(informative(0, forward, params_.aps.longitudinal_range_m), forward.dot(innovation), forward);
+      confirmed_along(informative(0, forward, along_range), grown(forward, along_range), forward.dot(innovation));
   const bool across = informative(1, left, params_.aps.lateral_range_m) && !curbs_hold_lateral;
   if (along && across)
     filter_->update_intensity(aps.position, R, J);  // KF2
@@ -722,9 +725,8 @@ void Localizer::fuse_intensity(const ApsResult& aps, const IntensityGrid& grid, 
 // full confidence (dynamic_campus under harsh, seed 1: 9.4 m for the whole run). Its position along the
 // road is taken, as the relocalization's places are, only when the next scan's match agrees with it
 // (within relocalization.confirm_distance_m); held back meanwhile. In the paper's window: at once.
-bool Localizer::confirmed_along(bool informative, double innovation_along, const Eigen::Vector2d& forward) {
-  const double spread = std::sqrt(forward.dot(filter_->covariance().topLeftCorner<2, 2>() * forward));
-  if (!informative || params_.aps_window_sigmas * spread <= params_.aps.longitudinal_range_m) {
+bool Localizer::confirmed_along(bool informative, bool grown, double innovation_along) {
+  if (!informative || !grown) {
     held_along_.reset();
     return informative;
   }

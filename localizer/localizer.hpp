@@ -188,9 +188,9 @@ class Localizer {
   void judge_gps_jump(const Pose2d& placed);
   // A map match the filter took (updated from `prior`), pinning down these axes of the car.
   void agree(const Pose2d& prior, bool along, bool across);
-  // Whether APS's innovation along the road (unit `forward`), informative by itself, may update the
-  // filter (see the .cpp).
-  bool confirmed_along(bool informative, double innovation_along, const Eigen::Vector2d& forward);
+  // Whether APS's innovation along the road, informative by itself, may update the filter, its window on
+  // that axis `grown` to the prior's spread (see the .cpp).
+  bool confirmed_along(bool informative, bool grown, double innovation_along);
   double position_sigma() const;  // the filter's, largest axis
   void report_pose(LocalizerEstimate& e);
   // The chi^2 gate, with the filter's doubt growing after max_rejections in a row (see
@@ -222,8 +222,8 @@ class Localizer {
 
   // APS's noise as its innovations show it, apart on straights and in bends (IntensityGrid::turning):
   // in a bend S is one scan, de-skewed through the turn, and its curved paint ties the position along
-  // the road to the heading; there APS erred 2.3 times as far as on the straights while its spread
-  // claimed less (gps_degraded at b9e57ab: RMS longitudinal error 0.31 m against 0.13 m).
+  // the road to the heading; there APS erred 2.5 times as far as on the straights while its spread
+  // claimed less (gps_degraded at b9e57ab: RMS longitudinal error 0.31 m against 0.125 m).
   InnovationScale aps_scale_straight_, aps_scale_turning_;
   // A grown window's APS innovation along the road, held back until the next scan's agrees with it.
   std::optional<double> held_along_;
