@@ -17,6 +17,8 @@ namespace {
 // may index a whole city), buckets grow instead: the answer stays exact, the memory bounded.
 constexpr double kMaxBucketsPerPoint = 4.0;
 constexpr double kMinBucketBudget = 4096;
+// nearest_within scans rings of buckets up to this many bucket sizes out; beyond, it asks the tree.
+constexpr double kMaxRings = 4;
 }  // namespace
 
 MapIndex::MapIndex(std::vector<Eigen::Vector2d> points, double bucket_m, Queries queries) : points_(std::move(points)) {
@@ -86,27 +88,42 @@ std::pair<size_t, double> MapIndex::nearest_within(const Eigen::Vector2d& p, dou
   constexpr std::pair<size_t, double> none{SIZE_MAX, std::numeric_limits<double>::infinity()};
   if (points_.empty() || !p.allFinite() || !(radius >= 0)) return none;
   const Buckets& b = buckets_;
-  if (radius > b.size) {  // the circle reaches past the neighbouring buckets: the tree is cheaper
+  const double rings = std::max(1.0, std::ceil(radius / b.size));
+  if (rings > kMaxRings) {  // the circle spans many buckets: the tree is cheaper
     const auto found = nearest(p);
     return found.second <= radius ? found : none;
   }
-  // The 3 x 3 buckets around p hold every point within one bucket size of it. The range is clamped in
-  // double, so a query far off the map cannot overflow an int.
   const double fc = std::floor((p.x() - b.origin.x()) / b.size), fr = std::floor((p.y() - b.origin.y()) / b.size);
-  const double c0 = std::max(fc - 1, 0.0), c1 = std::min(fc + 1, double(b.cols - 1));
-  const double r0 = std::max(fr - 1, 0.0), r1 = std::min(fr + 1, double(b.rows - 1));
-  if (c0 > c1 || r0 > r1) return none;
   double best_squared = radius * radius;
   size_t best = SIZE_MAX;
-  for (int r = int(r0); r <= int(r1); ++r) {
-    const size_t row = size_t(r) * size_t(b.cols);
-    for (uint32_t i = b.start[row + size_t(c0)], end = b.start[row + size_t(c1) + 1]; i < end; ++i) {
-      const double d = (b.sorted[i] - p).squaredNorm();
-      if (d < best_squared || (d == best_squared && b.index[i] < best)) {
-        best_squared = d;
-        best = b.index[i];
+  // Buckets r0..r1 x c0..c1, clamped to the grid in double first (so a query far off the map neither
+  // overflows an int nor loops on doubles too large to step); each row's run is contiguous.
+  auto scan = [&](double r0, double r1, double c0, double c1) {
+    r0 = std::max(r0, 0.0);
+    r1 = std::min(r1, double(b.rows - 1));
+    c0 = std::max(c0, 0.0);
+    c1 = std::min(c1, double(b.cols - 1));
+    if (r0 > r1 || c0 > c1) return;
+    for (int r = int(r0); r <= int(r1); ++r) {
+      const size_t row = size_t(r) * size_t(b.cols);
+      for (uint32_t i = b.start[row + size_t(c0)], end = b.start[row + size_t(c1) + 1]; i < end; ++i) {
+        const double d = (b.sorted[i] - p).squaredNorm();
+        if (d < best_squared || (d == best_squared && b.index[i] < best)) {
+          best_squared = d;
+          best = b.index[i];
+        }
       }
     }
+  };
+  // The 3 x 3 buckets around p hold every point within one bucket size of it; ring k beyond them (the
+  // buckets k away) every point within k sizes. A match mostly lies within centimetres of its curb, in
+  // the first block, so the rings stop as soon as nothing farther can be nearer.
+  scan(fr - 1, fr + 1, fc - 1, fc + 1);
+  for (int k = 2; k <= int(rings) && best_squared > double((k - 1) * (k - 1)) * b.size * b.size; ++k) {
+    scan(fr - k, fr - k, fc - k, fc + k);
+    scan(fr + k, fr + k, fc - k, fc + k);
+    scan(fr - k + 1, fr + k - 1, fc - k, fc - k);
+    scan(fr - k + 1, fr + k - 1, fc + k, fc + k);
   }
   return best == SIZE_MAX ? none : std::pair<size_t, double>{best, std::sqrt(best_squared)};
 }

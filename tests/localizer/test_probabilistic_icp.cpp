@@ -85,14 +85,15 @@ TEST(IcpMapIndex, NearestPointAndDistance) {
 }
 
 // The buckets must give the KD-tree's answer whenever it lies within the gate, and nothing otherwise,
-// for gates up to a bucket (buckets) and beyond (tree), inside the map and far off it.
+// for gates up to a bucket (one block of buckets), up to four (rings of them) and beyond (tree), inside
+// the map and far off it.
 TEST(IcpMapIndex, NearestWithinAgreesWithTheTree) {
   const std::vector<Eigen::Vector2d> map = road_map();
   const MapIndex index(map);
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-45, 45);
   size_t found = 0;
-  for (double gate : {0.05, 0.3, 1.0, 2.5}) {
+  for (double gate : {0.05, 0.3, 1.0, 1.7, 2.5}) {
     for (int k = 0; k < 2000; ++k) {
       const Eigen::Vector2d q(u(rng), u(rng));
       const auto [ti, td] = index.nearest(q);
@@ -107,6 +108,11 @@ TEST(IcpMapIndex, NearestWithinAgreesWithTheTree) {
     }
   }
   EXPECT_GT(found, 200u);  // the queries did land near curbs often enough to test something
+  // An index without a tree answers gates up to four buckets from its rings, and refuses wider ones.
+  const MapIndex rings_only(map, 0.5, MapIndex::Queries::within_only);
+  const Eigen::Vector2d near_curb = map[map.size() / 2] + Eigen::Vector2d(1.3, 1.3);
+  EXPECT_NEAR(rings_only.nearest_within(near_curb, 2.0).second, index.nearest(near_curb).second, 1e-12);
+  EXPECT_THROW(rings_only.nearest_within(near_curb, 2.5), std::logic_error);
   // A point exactly on the gate counts; NaN and far-away queries find nothing, without a crash.
   EXPECT_EQ(MapIndex({{0, 0}, {3, 0}}).nearest_within({0.0, 0.5}, 0.5).first, 0u);
   EXPECT_EQ(index.nearest_within({std::nan(""), 0.0}, 1.0).first, SIZE_MAX);
