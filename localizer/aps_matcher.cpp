@@ -248,23 +248,64 @@ std::vector<char> cells_near_obstacles(const std::vector<Eigen::Vector2d>& obsta
   const int w = p.width_cells, h = p.height_cells;
   std::vector<char> near(size_t(w) * size_t(h), 0);
   if (!(p.obstacle_distance > 0)) return near;
-  const int reach = int(std::ceil(p.obstacle_distance / p.cell_m)) + 1;
   const double d2 = p.obstacle_distance * p.obstacle_distance;
-  for (const Eigen::Vector2d& o : obstacles) {
-    const double col = std::floor(o.x() / p.cell_m + 0.5 * w), row = std::floor(o.y() / p.cell_m + 0.5 * h);
-    // Off S by more than the reach (or not finite): no cell of S is that close.
-    if (!(col >= -reach && col < w + reach && row >= -reach && row < h + reach)) continue;
-    const int c0 = int(col), r0 = int(row);
-    for (int r = std::max(r0 - reach, 0); r <= std::min(r0 + reach, h - 1); ++r) {
-      const double cy = (r + 0.5 - 0.5 * h) * p.cell_m - o.y();
-      if (cy * cy > d2) continue;  // the disk misses this row (about half the rows the reach spans)
-      char* cells = &near[size_t(r) * size_t(w)];
-      for (int c = std::max(c0 - reach, 0); c <= std::min(c0 + reach, w - 1); ++c) {
-        const double cx = (c + 0.5 - 0.5 * w) * p.cell_m - o.x();
-        if (cx * cx + cy * cy <= d2) cells[c] = 1;
+  // A parked row returns thousands of points a scan, a few to a cell. So the points are grouped by the
+  // cell they fall in (on S grown by the reach on every side: a car just off S still masks S's edge),
+  // and each cell's neighbours are settled once: those within the distance of any point of the cell are
+  // marked without a test, those beyond it of every point skipped, and only the ring between tests the
+  // cell's points, until one is near enough.
+  const int reach = int(std::ceil(p.obstacle_distance / p.cell_m)) + 1;
+  const int pw = w + 2 * reach, ph = h + 2 * reach;
+  auto padded_cell = [&](const Eigen::Vector2d& o) -> std::optional<size_t> {
+    const double col = std::floor(o.x() / p.cell_m + 0.5 * w) + reach,
+                 row = std::floor(o.y() / p.cell_m + 0.5 * h) + reach;
+    if (!(col >= 0 && col < pw && row >= 0 && row < ph)) return std::nullopt;  // off S's reach, or NaN
+    return size_t(row) * size_t(pw) + size_t(col);
+  };
+  std::vector<uint32_t> start(size_t(pw) * size_t(ph) + 1, 0);
+  for (const Eigen::Vector2d& o : obstacles)
+    if (const auto k = padded_cell(o)) ++start[*k + 1];
+  for (size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  std::vector<Eigen::Vector2d> sorted(start.back());
+  for (const Eigen::Vector2d& o : obstacles)
+    if (const auto k = padded_cell(o)) sorted[fill[*k]++] = o;
+
+  // Neighbour offsets by how far their centre can be from a point of the cell: the centres' distance
+  // give or take half the cell's diagonal (with a margin for rounding: the test itself decides then).
+  struct Offset {
+    int dc, dr;
+  };
+  std::vector<Offset> certain, tested;
+  const double half_diagonal = p.cell_m * std::sqrt(0.5), margin = 1e-9 * p.obstacle_distance;
+  for (int dr = -reach; dr <= reach; ++dr)
+    for (int dc = -reach; dc <= reach; ++dc) {
+      const double apart = std::hypot(dc, dr) * p.cell_m;
+      if (apart + half_diagonal < p.obstacle_distance - margin)
+        certain.push_back({dc, dr});
+      else if (apart - half_diagonal <= p.obstacle_distance + margin)
+        tested.push_back({dc, dr});
+    }
+  for (int pr = 0; pr < ph; ++pr)
+    for (int pc = 0; pc < pw; ++pc) {
+      const size_t k = size_t(pr) * size_t(pw) + size_t(pc);
+      if (start[k] == start[k + 1]) continue;
+      const int c = pc - reach, r = pr - reach;  // in S's cells
+      for (const Offset& o : certain)
+        if (c + o.dc >= 0 && c + o.dc < w && r + o.dr >= 0 && r + o.dr < h)
+          near[size_t(r + o.dr) * size_t(w) + size_t(c + o.dc)] = 1;
+      for (const Offset& o : tested) {
+        const int tc = c + o.dc, tr = r + o.dr;
+        if (tc < 0 || tc >= w || tr < 0 || tr >= h) continue;
+        char& cell = near[size_t(tr) * size_t(w) + size_t(tc)];
+        if (cell) continue;
+        const double x = (tc + 0.5 - 0.5 * w) * p.cell_m, y = (tr + 0.5 - 0.5 * h) * p.cell_m;
+        for (uint32_t i = start[k]; i < start[k + 1] && !cell; ++i) {
+          const double cx = x - sorted[i].x(), cy = y - sorted[i].y();
+          cell = cx * cx + cy * cy <= d2;
+        }
       }
     }
-  }
   return near;
 }
 

@@ -41,13 +41,16 @@ TEST(IntensityObstacleMask, CellsWithinTheDistanceOfAnObstacleAreMarked) {
 }
 
 TEST(IntensityObstacleMask, MarksExactlyTheCellsWhoseCentresAreWithinTheDistance) {
-  // Random obstacles, some off the grid, against the definition cell by cell.
+  // Random obstacles, some off the grid, and a dense row of them, against the definition cell by cell.
   for (double distance : {0.5, 0.33, 1.0}) {
     const IntensityGridParams p = params(distance);
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> coordinate(-10.6, 10.6);
     std::vector<Eigen::Vector2d> obstacles;
     for (int k = 0; k < 300; ++k) obstacles.push_back({coordinate(rng), coordinate(rng)});
+    // And a car's side: many points to a cell, as a parked row returns them.
+    std::uniform_real_distribution<double> along(3.0, 7.5), across(-2.1, -1.7);
+    for (int k = 0; k < 1500; ++k) obstacles.push_back({along(rng), across(rng)});
     const std::vector<char> mask = cells_near_obstacles(obstacles, p);
     for (int r = 0; r < p.height_cells; ++r)
       for (int c = 0; c < p.width_cells; ++c) {
