@@ -10,10 +10,9 @@ double wrap_angle(double a) {
   return a <= -std::numbers::pi ? a + 2 * std::numbers::pi : a;
 }
 
-Eigen::Vector2d Pose2d::apply(const Eigen::Vector2d& p) const {
-  const double c = std::cos(yaw), s = std::sin(yaw);
-  return {c * p.x() - s * p.y() + x, s * p.x() + c * p.y() + y};
-}
+Eigen::Vector2d Pose2d::apply(const Eigen::Vector2d& p) const { return PoseApplier(*this)(p); }
+
+PoseApplier::PoseApplier(const Pose2d& pose) : c(std::cos(pose.yaw)), s(std::sin(pose.yaw)), x(pose.x), y(pose.y) {}
 
 Pose2d Pose2d::compose(const Pose2d& b) const {
   const double c = std::cos(yaw), s = std::sin(yaw);

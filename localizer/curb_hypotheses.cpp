@@ -44,8 +44,9 @@ CurbHypothesis scored(const std::vector<Eigen::Vector2d>& features, const MapInd
   h.pose = correction.compose(prior);
   size_t inliers = 0;
   double residuals = 0, kernel = 0;
+  const PoseApplier corrected(correction);
   for (const Eigen::Vector2d& f : features) {
-    const double d = map.nearest_within(correction.apply(f), inlier_distance).second;
+    const double d = map.nearest_within(corrected(f), inlier_distance).second;
     if (!(d <= inlier_distance)) continue;
     ++inliers;
     residuals += d;

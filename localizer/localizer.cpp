@@ -442,9 +442,9 @@ void Localizer::calibrate_lasers_to_each_other(const ScanPoints& points, const s
 void Localizer::calibrate_lasers_to_the_map(const ScanPoints& points, const std::vector<size_t>& ground) {
   const IntensityCalibrationParams& c = params_.intensity_calibration;
   if (!c.enabled || ground.empty()) return;
-  const Pose2d pose = filter_->pose();
+  const PoseApplier to_local(filter_->pose());
   for (size_t k = 0; k < ground.size(); k += size_t(c.point_stride)) {
-    const std::optional<IntensityCell> cell = map_.intensity.cell(pose.apply(points.xyz[ground[k]].head<2>()));
+    const std::optional<IntensityCell> cell = map_.intensity.cell(to_local(points.xyz[ground[k]].head<2>()));
     if (cell && int(cell->count) >= c.min_map_count)
       intensity_calibration_.add(points.ring[ground[k]], points.intensity[ground[k]], cell->mean);
   }

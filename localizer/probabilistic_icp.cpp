@@ -55,8 +55,9 @@ void score(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs, doubl
            IcpResult& result) {
   double sum_squared = 0;
   size_t inliers = 0;
+  const PoseApplier t(result.t);
   for (const auto& c : curbs) {
-    const double d = map.nearest_within(result.t.apply(c), gate).second;
+    const double d = map.nearest_within(t(c), gate).second;
     if (d <= gate && weight(d) > 0) {
       ++inliers;
       sum_squared += d * d;
@@ -84,8 +85,9 @@ IcpResult run_icp(const MapIndex& map, const std::vector<Eigen::Vector2d>& curbs
     src.clear();
     dst.clear();
     w.clear();
+    const PoseApplier t(result.t);
     for (const auto& c : curbs) {
-      const Eigen::Vector2d p = result.t.apply(c);
+      const Eigen::Vector2d p = t(c);
       const auto [index, d] = map.nearest_within(p, gate);
       if (index == SIZE_MAX) continue;
       const double wi = weight(d);

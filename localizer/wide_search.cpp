@@ -476,9 +476,9 @@ Work refine(WideApsCandidate& cand, const IntensityGrid& S, IntensityMap& map, c
 Work verdict(std::vector<WideApsCandidate>& refined, const IntensityGrid& S, IntensityMap& map,
              const WideApsParams& p) {
   std::vector<WideApsCandidate*> live;
-  std::vector<Pose2d> poses;
+  std::vector<PoseApplier> poses;
   for (WideApsCandidate& c : refined)
-    if (std::isfinite(c.log_p_per_cell)) live.push_back(&c), poses.push_back(c.correction.compose(S.pose));
+    if (std::isfinite(c.log_p_per_cell)) live.push_back(&c), poses.emplace_back(c.correction.compose(S.pose));
   std::vector<double> sums(live.size(), 0.0), terms(live.size());
   int cells = 0;
   for (int r = 0; r < S.params.height_cells; ++r)
@@ -489,7 +489,7 @@ Work verdict(std::vector<WideApsCandidate>& refined, const IntensityGrid& S, Int
       const double s_sigma = aps_cell_sigma(s, p.aps.min_sigma);
       bool under_all = true;
       for (size_t k = 0; k < live.size() && under_all; ++k) {
-        const std::optional<IntensityCell> m = map.cell(poses[k].apply(v));
+        const std::optional<IntensityCell> m = map.cell(poses[k](v));
         under_all = m && m->count > 0;
         if (!under_all) break;
         const double d = m->mean - s.mean, e = aps_cell_sigma(*m, p.aps.min_sigma) + s_sigma;
