@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "common/units.hpp"
 #include "common/vehicle_messages.hpp"
 #include "localizer/probabilistic_icp.hpp"
 
@@ -24,11 +25,15 @@ struct CurbMatchNoise {
   // metres of driving). Features count as one per square of this side (m) that holds any.
   double correlation_length_m = 4.0;
   double inlier_distance_m = 1.0;  // features farther from the map than this carry no information (d_g)
-  // Floors, so that a perfect-looking match is never trusted beyond what a map can be trusted. Set
-  // from the scenario suite's consistency, not from a source: at 0.03 m this floor alone made the filter
-  // claim 2-3 times its lateral error (mean NEES 0.14 on dynamic_campus; 0.84 at 0.01 m).
+  // Floors, so that a perfect-looking match is never trusted beyond what a map can be trusted. The
+  // position's is set from the scenario suite's consistency, not from a source: at 0.03 m this floor
+  // alone made the filter claim 2-3 times its lateral error (mean NEES 0.14 on dynamic_campus; 0.84 at
+  // 0.01 m). The heading's is the survey's: the map's curbs are placed with the mapping car's heading,
+  // 0.050 deg RMS (Applanix POS LV 220 datasheet, RTK; loop/survey_error.hpp). At 0.115 deg, set like
+  // the position's, the filter claimed 2.5 times its heading scatter (suite mean heading NEES 0.47;
+  // 0.56 at 0.05 deg, misleading frames 0 and 1 of 3694).
   double min_sigma_m = 0.01;
-  double min_sigma_yaw_rad = 0.002;
+  double min_sigma_yaw_rad = 0.05 * kDeg;
   // A direction without any curb information gets this standard deviation rather than an infinite one
   // (an observation with a huge variance leaves the filter's estimate there as it was).
   double unconstrained_sigma_m = 100.0;
