@@ -191,6 +191,7 @@ Localizer::Localizer(HdMap& map, const LocalizerParams& params)
       intensity_calibration_(params.intensity_calibration),
       lost_(params.lost),
       gps_steps_(params.gps_steps),
+      gps_jitter_(params.gps_noise.jitter),
       relocalizer_(params.relocalization) {}
 
 void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance) {
@@ -200,8 +201,7 @@ void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Ma
 
 void Localizer::displace(const Pose2d& offset) {
   if (!filter_) return;
-  const Eigen::Matrix3d covariance = filter_->covariance();
-  filter_.emplace(filter_->pose().compose(offset), covariance, params_.filter);
+  filter_->displace_to(filter_->pose().compose(offset));
 }
 
 std::optional<Pose2d> Localizer::pose() const {
@@ -236,6 +236,13 @@ void Localizer::on_can(const CanFrame& f) {
   last_can_ns_ = f.stamp_ns;
 }
 
+// The receiver's variance, times `scale`, as white noise: no bias state.
+static GpsErrorModel white_gps(const Eigen::Vector3d& reported, double scale) {
+  GpsErrorModel m;
+  m.white_variance = reported * scale;
+  return m;
+}
+
 void Localizer::on_gps(const GpsFix& fix) {
   if (fix.status == GpsStatus::no_fix) return;
   if (!std::isfinite(fix.lat_deg) || !std::isfinite(fix.lon_deg) || !std::isfinite(fix.heading_rad)) return;
@@ -249,15 +256,20 @@ void Localizer::on_gps(const GpsFix& fix) {
   auto variance = [&](double reported, double floor) {
     return std::isfinite(reported) ? std::max(reported, floor * floor) : floor * floor;
   };
-  const Eigen::Matrix3d R = Eigen::Vector3d(variance(fix.position_covariance[0], n.min_sigma_m),
-                                            variance(fix.position_covariance[4], n.min_sigma_m),
-                                            variance(fix.heading_variance, n.min_heading_sigma_rad))
-                                .asDiagonal();
+  // The receiver's own word: the stationary variance of its error.
+  const Eigen::Vector3d reported(variance(fix.position_covariance[0], n.min_sigma_m),
+                                 variance(fix.position_covariance[4], n.min_sigma_m),
+                                 variance(fix.heading_variance, n.min_heading_sigma_rad));
+  const Eigen::Matrix3d R = reported.asDiagonal();
+  const Eigen::Vector3d z(p.x(), p.y(), wrap_angle(fix.heading_rad));
+  const std::optional<GpsPair> previous = previous_fix_;
+  previous_fix_ = GpsPair{fix.stamp_ns, z, odometry_};
   last_gps_ns_ = fix.stamp_ns;
   if (!filter_) {
-    // One fix is as good as the receiver says; the scale is for the correlation between many. A cold
-    // start: lost until the map has pinned the pose down.
-    filter_.emplace(Pose2d{p.x(), p.y(), wrap_angle(fix.heading_rad)}, R, params_.filter);
+    // A cold start: lost until the map has pinned the pose down.
+    // One fix is as good as the receiver says; a scale is for the correlation between many.
+    filter_ = PoseFilter::from_gps_fix(z, n.bias_state ? gps_error_model(reported) : white_gps(reported, 1.0),
+                                       params_.filter);
     last_fix_ = {filter_->pose(), R};
     lost_.start_search();
     trusted_.reset();
@@ -283,16 +295,29 @@ void Localizer::on_gps(const GpsFix& fix) {
     }
     return;
   }
+  if (!stepped && previous && double(fix.stamp_ns - previous->stamp_ns) / kNsPerS <= params_.health.gps_timeout_s) {
+    // The change since the previous fix less the car's motion by odometry (turned into the local frame
+    // by the filter's heading): two fixes' white noise.
+    const Pose2d moved = relative(previous->odometry, odometry_);
+    const Eigen::Vector2d travelled = Eigen::Rotation2Dd(filter_->pose().yaw) * Eigen::Vector2d(moved.x, moved.y);
+    gps_jitter_.add(Eigen::Vector3d(z.x() - previous->z.x() - travelled.x(), z.y() - previous->z.y() - travelled.y(),
+                                    wrap_angle(z.z() - previous->z.z() - moved.yaw)));
+  }
+  // With the bias a state: which part of the error is white is not known before the jitter is.
+  if (n.bias_state && !gps_jitter_.calibrated()) return;
+  const GpsErrorModel model = n.bias_state ? gps_error_model(reported) : white_gps(reported, n.variance_scale);
   if (lost_.lost()) {
     // Lost: the filter itself moves, so steps say nothing new; only the fixes that stepped before (the
     // GPS may be what jumped) wait for the map's verdict.
-    if (!(gps_stepped_ && stepped))
-      filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
+    if (!(gps_stepped_ && stepped)) filter_->update_gps(z, model);  // KF1
     return;
   }
-  // The fix itself beyond the receiver's own error (its variance, not the scaled one), or a step.
-  const Eigen::Matrix2d S = filter_->covariance().topLeftCorner<2, 2>() + R.topLeftCorner<2, 2>();
-  if (stepped || innovation.dot(S.ldlt().solve(innovation)) > params_.health.gate_gps) {
+  // The fix against the filter's pose and bias (with the receiver's own variance, not the scaled one),
+  // or a step.
+  const Eigen::Vector2d nu = filter_->gps_innovation(z).head<2>();
+  const Eigen::Matrix2d S =
+      filter_->gps_innovation_covariance(n.bias_state ? model : white_gps(reported, 1.0)).topLeftCorner<2, 2>();
+  if (stepped || nu.dot(S.ldlt().solve(nu)) > params_.health.gate_gps) {
     if (stepped && gps_steps_.level()) {
       gps_stepped_ = true;
       last_gps_step_ = innovation - *gps_steps_.level();
@@ -300,7 +325,18 @@ void Localizer::on_gps(const GpsFix& fix) {
     disagree(innovation, true);
     return;
   }
-  filter_->update_gps(Eigen::Vector3d(p.x(), p.y(), fix.heading_rad), R * n.variance_scale);  // KF1
+  filter_->update_gps(z, model);  // KF1
+}
+
+// The receiver's stationary variance split into white noise (as its jitter shows it, never more than
+// the whole) and the bias, the rest.
+GpsErrorModel Localizer::gps_error_model(const Eigen::Vector3d& reported) const {
+  const GpsNoise& n = params_.gps_noise;
+  GpsErrorModel m;
+  m.white_variance = gps_jitter_.white_variance().cwiseMin(reported);
+  m.bias_variance = reported - m.white_variance;
+  m.tau_s = Eigen::Vector3d(n.bias_tau_s, n.bias_tau_s, n.heading_bias_tau_s);
+  return m;
 }
 
 uint32_t Localizer::input_health(int64_t t_ns) const {
@@ -844,7 +880,8 @@ void Localizer::move_to(const Relocation& found) {
     const double yaw_variance = (found.heading ? new_vehicle : old_vehicle)(2, 2);
     covariance = R * Eigen::Vector3d(old_vehicle(0, 0), new_vehicle(1, 1), yaw_variance).asDiagonal() * R.transpose();
   }
-  filter_.emplace(found.pose, covariance, params_.filter);
+  const Eigen::Vector2d forward(std::cos(found.pose.yaw), std::sin(found.pose.yaw));
+  filter_->reset_pose(found.pose, covariance, found.longitudinal ? std::nullopt : std::optional(forward));
   if (!found.longitudinal) return;  // still lost: the next scan searches again, narrower across
   lost_.found();
   judge_gps_jump(found.pose);

@@ -196,6 +196,7 @@ class Localizer {
   // The chi^2 gate, with the filter's doubt growing after max_rejections in a row (see
   // HealthParams); true: use the observation.
   bool gate(double mahalanobis_sq, double threshold, int& rejections);
+  GpsErrorModel gps_error_model(const Eigen::Vector3d& reported) const;
 
   HdMap& map_;
   LocalizerParams params_;
@@ -229,6 +230,14 @@ class Localizer {
   std::optional<double> held_along_;
   LostDetector lost_;
   GpsStepDetector gps_steps_;
+  GpsJitter gps_jitter_;
+  // The previous fix (rear axle, local frame; heading) and the odometry then: the jitter's pair.
+  struct GpsPair {
+    int64_t stamp_ns;
+    Eigen::Vector3d z;
+    Pose2d odometry;
+  };
+  std::optional<GpsPair> previous_fix_;
   Relocalizer relocalizer_;
   Eigen::Vector3d search_sigmas_ = Eigen::Vector3d::Zero();  // longitudinal, lateral (m), yaw (rad)
   bool gps_stepped_ = false;  // the GPS's disagreement that made the localizer lost was a step

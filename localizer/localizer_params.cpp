@@ -263,11 +263,20 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("unconstrained_sigma_m", p.curb_noise.unconstrained_sigma_m, 1.0, 1e6)
       .integer("refine_iterations", p.curb_noise.refine_iterations, 0, 100)
       .done();
-  YamlMap(y, top["gps_noise"], "gps_noise")
-      .number("min_sigma_m", p.gps_noise.min_sigma_m, 0.0, 100.0)
+  YamlMap gps_noise(y, top["gps_noise"], "gps_noise");
+  gps_noise.number("min_sigma_m", p.gps_noise.min_sigma_m, 0.0, 100.0)
       .number("min_heading_sigma_rad", p.gps_noise.min_heading_sigma_rad, 0.0, 3.2)
       .number("variance_scale", p.gps_noise.variance_scale, 1e-3, 1e6)
+      .boolean("bias_state", p.gps_noise.bias_state)
+      .number("bias_tau_s", p.gps_noise.bias_tau_s, 0.1, 1e5)
+      .number("heading_bias_tau_s", p.gps_noise.heading_bias_tau_s, 0.1, 1e5);
+  YamlMap(y, gps_noise["jitter"], "gps_noise.jitter")
+      .integer("window", p.gps_noise.jitter.window, 1, 1000000)
+      .integer("min_samples", p.gps_noise.jitter.min_samples, 1, 1000000)
+      .number("gate_xy", p.gps_noise.jitter.gate_xy, 1.0, 1e6)
+      .number("gate_yaw", p.gps_noise.jitter.gate_yaw, 1.0, 1e6)
       .done();
+  gps_noise.done();
   YamlMap(y, top["health"], "health")
       .number("gps_timeout_s", p.health.gps_timeout_s, 0.01, 1e4)
       .number("can_timeout_s", p.health.can_timeout_s, 0.001, 1e4)

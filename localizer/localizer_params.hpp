@@ -17,6 +17,7 @@
 #include "localizer/driving_corridor.hpp"
 #include "localizer/fmt_matcher.hpp"
 #include "localizer/gicp_matcher.hpp"
+#include "localizer/gps_jitter.hpp"
 #include "localizer/gps_step_detector.hpp"
 #include "localizer/intensity_calibration.hpp"
 #include "localizer/lost_detector.hpp"
@@ -63,13 +64,24 @@ struct MountUncertainty {
 struct GpsNoise {
   double min_sigma_m = 0.5;  // floor on the receiver's reported position sigma
   double min_heading_sigma_rad = 0.02;
-  // Scales the receiver's variances. A low-cost receiver's error is mostly a slowly wandering bias
-  // (Gauss-Markov, tau of minutes), so fixes 0.1 s apart are far from independent, and a filter that
-  // takes each as news is pulled to the bias within seconds wherever the map says little (between
-  // paint marks, beside a coach). 10 counts ten fixes as one. Measured on the scenario suite (seeds
-  // 5, 7, 8): dynamic_campus longitudinal RMSE 0.17-0.18 m against 0.19-0.26 m with 1, and
-  // bus_occlusion's worst error 0.24-0.28 m against 0.68 m.
+  // A low-cost receiver's error is mostly a slowly wandering bias (Gauss-Markov, tau of minutes), so
+  // fixes 0.1 s apart are far from independent, and a filter that takes each as news is pulled to the
+  // bias within seconds wherever the map says little (between paint marks, beside a coach). Two ways
+  // to say so:
+  // - variance_scale (the default): each fix's variance is the receiver's times this; 10 counts ten
+  //   fixes as one. Measured on the scenario suite (seeds 5, 7, 8): dynamic_campus longitudinal RMSE
+  //   0.17-0.18 m against 0.19-0.26 m with 1, and bus_occlusion's worst error 0.24-0.28 m against 0.68 m.
+  // - bias_state: the filter carries the bias as a state (pose_filter.hpp); each fix's white part is
+  //   learnt from its jitter (gps_jitter.hpp), the rest of the receiver's variance is the bias's.
   double variance_scale = 10.0;
+  bool bias_state = false;
+  // The bias's correlation time, which no fix tells (the receiver reports only its stationary error).
+  // A low-cost receiver's bias wanders over minutes (ionosphere, troposphere, multipath: Groves 2013,
+  // ch. 9); one minute is the short end, the cautious one: a filter that thinks the bias forgets sooner
+  // trusts what it learnt of it less.
+  double bias_tau_s = 60.0;
+  double heading_bias_tau_s = 60.0;
+  GpsJitterParams jitter;
 };
 
 // A localizer that is another program, in the loop instead of a built-in method (`exec:PROGRAM ARGS`;

@@ -46,42 +46,124 @@ Pose2d MotionPredictor::predict(const Pose2d& pose, double v, double delta, doub
 }
 
 PoseFilter::PoseFilter(const Pose2d& initial, const Eigen::Matrix3d& covariance, const PoseFilterParams& params)
-    : x_(initial.x, initial.y, initial.yaw), P_(covariance), params_(params) {}
+    : params_(params) {
+  x_.head<3>() = Eigen::Vector3d(initial.x, initial.y, initial.yaw);
+  P_.topLeftCorner<3, 3>() = covariance;
+}
+
+PoseFilter PoseFilter::from_gps_fix(const Eigen::Vector3d& z, const GpsErrorModel& gps,
+                                    const PoseFilterParams& params) {
+  const Eigen::Matrix3d B = gps.bias_variance.asDiagonal();
+  PoseFilter f({z.x(), z.y(), wrap_angle(z.z())}, B + Eigen::Matrix3d(gps.white_variance.asDiagonal()), params);
+  f.gps_ = gps;
+  f.P_.bottomRightCorner<3, 3>() = B;
+  f.P_.topRightCorner<3, 3>() = -B;  // pose = z - bias - white
+  f.P_.bottomLeftCorner<3, 3>() = -B;
+  return f;
+}
+
+void PoseFilter::start_bias(const GpsErrorModel& gps) {
+  if (gps_) return;
+  gps_ = gps;
+  x_.tail<3>().setZero();
+  P_.bottomRightCorner<3, 3>() = gps.bias_variance.asDiagonal();
+  P_.topRightCorner<3, 3>().setZero();
+  P_.bottomLeftCorner<3, 3>().setZero();
+}
+
+void PoseFilter::reset_pose(const Pose2d& pose, const Eigen::Matrix3d& covariance,
+                            const std::optional<Eigen::Vector2d>& keep_along) {
+  // In a frame whose first axis is `keep_along` (any, without it), for the pose and the bias alike.
+  const Eigen::Vector2d u = keep_along.value_or(Eigen::Vector2d::UnitX()).normalized();
+  Eigen::Matrix3d to_frame = Eigen::Matrix3d::Identity();
+  to_frame.topLeftCorner<2, 2>() << u.x(), u.y(), -u.y(), u.x();
+  Matrix6d T = Matrix6d::Zero();
+  T.topLeftCorner<3, 3>() = to_frame;
+  T.bottomRightCorner<3, 3>() = to_frame;
+  const Matrix6d old = T * P_ * T.transpose();
+  Matrix6d P = Matrix6d::Zero();
+  P.topLeftCorner<3, 3>() = to_frame * covariance * to_frame.transpose();
+  if (gps_) P.bottomRightCorner<3, 3>() = to_frame * gps_->bias_variance.asDiagonal() * to_frame.transpose();
+  if (keep_along) {
+    for (int i : {0, 3})
+      for (int j : {0, 3}) P(i, j) = old(i, j);
+  }
+  P_ = T.transpose() * P * T;
+  x_.head<3>() = Eigen::Vector3d(pose.x, pose.y, pose.yaw);
+}
 
 void PoseFilter::predict(const Pose2d& predicted, double distance, double dt) {
   // Jacobian of moving by the odometry increment: a displacement (dx, dy) in the body frame rotates with psi.
-  const double dpx = predicted.x - x_.x(), dpy = predicted.y - x_.y();
-  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+  const double dpx = predicted.x - x_(0), dpy = predicted.y - x_(1);
+  Matrix6d F = Matrix6d::Identity();
   F(0, 2) = -dpy;
   F(1, 2) = dpx;
-  x_ = Eigen::Vector3d(predicted.x, predicted.y, predicted.yaw);
+  x_.head<3>() = Eigen::Vector3d(predicted.x, predicted.y, predicted.yaw);
   auto sq = [](double v) { return v * v; };
   const double q_pos = sq(params_.position_per_sqrt_m) * distance + sq(params_.position_per_sqrt_s) * dt;
   const double q_yaw = sq(params_.yaw_per_sqrt_m) * distance;
-  const Eigen::Matrix3d Q = Eigen::Vector3d(q_pos, q_pos, q_yaw).asDiagonal();
-  P_ = F * P_ * F.transpose() + Q;
+  Vector6d q = Vector6d::Zero();
+  q.head<3>() = Eigen::Vector3d(q_pos, q_pos, q_yaw);
+  if (gps_) {
+    // The exact discretisation of the Gauss-Markov bias: it decays by phi and its stationary variance
+    // is kept by a fresh (1 - phi^2) of it.
+    for (int i = 0; i < 3; ++i) {
+      const double phi = std::exp(-std::max(0.0, dt) / gps_->tau_s(i));
+      x_(3 + i) *= phi;
+      F(3 + i, 3 + i) = phi;
+      q(3 + i) = gps_->bias_variance(i) * (1 - phi * phi);
+    }
+  }
+  P_ = F * P_ * F.transpose();
+  P_.diagonal() += q;
 }
 
 template <int N>
-void PoseFilter::update(const Eigen::Matrix<double, N, 1>& z, const Eigen::Matrix<double, N, N>& R,
-                        const Eigen::Matrix<double, N, 3>& H) {
-  Eigen::Matrix<double, N, 1> innovation = z - H * x_;
-  if constexpr (N == 3) innovation(2) = wrap_angle(innovation(2));  // angles as angles
+void PoseFilter::update(const Eigen::Matrix<double, N, 1>& innovation, const Eigen::Matrix<double, N, N>& R,
+                        const Eigen::Matrix<double, N, 6>& H) {
   const Eigen::Matrix<double, N, N> S = H * P_ * H.transpose() + R;
-  const Eigen::Matrix<double, 3, N> K = P_ * H.transpose() * S.inverse();
+  const Eigen::Matrix<double, 6, N> K = P_ * H.transpose() * S.inverse();
   x_ += K * innovation;
   x_(2) = wrap_angle(x_(2));
   // Joseph form: stays symmetric and positive definite whatever the rounding.
-  const Eigen::Matrix3d I_KH = Eigen::Matrix3d::Identity() - K * H;
+  const Matrix6d I_KH = Matrix6d::Identity() - K * H;
   P_ = I_KH * P_ * I_KH.transpose() + K * R * K.transpose();
 }
 
-void PoseFilter::update_gps(const Eigen::Vector3d& z, const Eigen::Matrix3d& R) {
-  update<3>(z, R, Eigen::Matrix3d::Identity());
+template <int N>
+void PoseFilter::update_pose(const Eigen::Matrix<double, N, 1>& z, const Eigen::Matrix<double, N, N>& R,
+                             const Eigen::Matrix<double, N, 3>& H) {
+  Eigen::Matrix<double, N, 1> innovation = z - H * x_.head<3>();
+  if constexpr (N == 3) innovation(2) = wrap_angle(innovation(2));  // angles as angles
+  Eigen::Matrix<double, N, 6> H6 = Eigen::Matrix<double, N, 6>::Zero();
+  H6.template leftCols<3>() = H;
+  update<N>(innovation, R, H6);
+}
+
+Eigen::Vector3d PoseFilter::gps_innovation(const Eigen::Vector3d& z) const {
+  Eigen::Vector3d innovation = z - x_.head<3>() - x_.tail<3>();
+  innovation(2) = wrap_angle(innovation(2));
+  return innovation;
+}
+
+Eigen::Matrix3d PoseFilter::gps_innovation_covariance(const GpsErrorModel& gps) const {
+  // H = [I I]; an unstarted bias is the model's stationary one.
+  const Eigen::Matrix3d B =
+      gps_ ? Eigen::Matrix3d(P_.bottomRightCorner<3, 3>()) : Eigen::Matrix3d(gps.bias_variance.asDiagonal());
+  const Eigen::Matrix3d cross = gps_ ? Eigen::Matrix3d(P_.topRightCorner<3, 3>()) : Eigen::Matrix3d::Zero();
+  return P_.topLeftCorner<3, 3>() + B + cross + cross.transpose() + Eigen::Matrix3d(gps.white_variance.asDiagonal());
+}
+
+void PoseFilter::update_gps(const Eigen::Vector3d& z, const GpsErrorModel& gps) {
+  start_bias(gps);
+  gps_ = gps;  // the receiver's word on its stationary error may change from fix to fix
+  Eigen::Matrix<double, 3, 6> H;
+  H << Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity();
+  update<3>(gps_innovation(z), gps.white_variance.asDiagonal().toDenseMatrix(), H);
 }
 
 void PoseFilter::update_curb(const Eigen::Vector3d& z, const Eigen::Matrix3d& R) {
-  update<3>(z, R, Eigen::Matrix3d::Identity());
+  update_pose<3>(z, R, Eigen::Matrix3d::Identity());
 }
 
 Eigen::Matrix<double, 2, 3> intensity_observation_matrix(const Eigen::Vector2d& J) {
@@ -92,13 +174,13 @@ Eigen::Matrix<double, 2, 3> intensity_observation_matrix(const Eigen::Vector2d& 
 
 // z = p + J (psi_prior - psi), i.e. z - J psi_prior = H x: the innovation stays z - p_prior.
 void PoseFilter::update_intensity(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& J) {
-  update<2>(z - J * x_.z(), R, intensity_observation_matrix(J));
+  update_pose<2>(z - J * x_(2), R, intensity_observation_matrix(J));
 }
 
 void PoseFilter::update_intensity_along(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& u,
                                         const Eigen::Vector2d& J) {
   const Eigen::Matrix<double, 1, 3> H = u.transpose() * intensity_observation_matrix(J);
-  update<1>(Eigen::Matrix<double, 1, 1>(u.dot(z - J * x_.z())), Eigen::Matrix<double, 1, 1>(u.dot(R * u)), H);
+  update_pose<1>(Eigen::Matrix<double, 1, 1>(u.dot(z - J * x_(2))), Eigen::Matrix<double, 1, 1>(u.dot(R * u)), H);
 }
 
 }  // namespace lidarloop

@@ -4,9 +4,18 @@
 // (x, y, psi) and intensity (x, y) (its KF2).
 //
 // The paper runs KF1 and feeds its output to KF2 as the prior. With independent measurement noise
-// that cascade equals one linear Kalman filter on [x, y, psi] updated in turn by each observation,
-// which is what this class is; the two updates keep the paper's names.
+// that cascade equals one linear Kalman filter updated in turn by each observation, which is what this
+// class is; the two updates keep the paper's names.
+//
+// Beyond the paper, the state carries the low-cost GPS's bias next to the pose: [x, y, psi, b_x, b_y,
+// b_psi]. A low-cost receiver's error is mostly a bias that wanders over minutes (ionosphere,
+// troposphere, multipath); taken as white noise, ten fixes a second would be counted as ten independent
+// looks at the car and pull it to the bias within seconds. Carried as a first-order Gauss-Markov state
+// (the standard GNSS error state: Groves, Principles of GNSS, Inertial, and Multisensor Integrated
+// Navigation Systems, 2nd ed., 2013), the bias is learnt wherever the map pins the pose, and a fix
+// then says only what its white noise allows.
 #include <cstdint>
+#include <optional>
 
 #include <Eigen/Core>
 
@@ -50,18 +59,37 @@ struct PoseFilterParams {
   double position_per_sqrt_s = 0.2;
 };
 
+// The low-cost GPS's error as the filter models it, per axis (x, y, psi): a Gauss-Markov bias of
+// stationary variance `bias_variance` and correlation time `tau_s`, plus white noise.
+struct GpsErrorModel {
+  Eigen::Vector3d bias_variance = Eigen::Vector3d::Zero();
+  Eigen::Vector3d white_variance = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tau_s = Eigen::Vector3d::Ones();
+};
+
 // The intensity observation's H: z = p + J (psi_prior - psi) is linear in (x, y, psi) with rows
 // [I, -J] (J: ApsResult::yaw_coupling; zero for a match that does not depend on the heading).
 Eigen::Matrix<double, 2, 3> intensity_observation_matrix(const Eigen::Vector2d& J);
 
 class PoseFilter {
  public:
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+  // A pose known from elsewhere (a map match, the caller): the GPS bias is unknown until the first fix.
   PoseFilter(const Pose2d& initial, const Eigen::Matrix3d& covariance, const PoseFilterParams& params = {});
+  // A cold start from one fix z (x, y, psi): the car is where the fix says, as far off as the fix's
+  // bias and white noise together, and whatever the bias turns out to be, the car is off by minus it.
+  static PoseFilter from_gps_fix(const Eigen::Vector3d& z, const GpsErrorModel& gps,
+                                 const PoseFilterParams& params = {});
 
   // Prediction: the pose moves to `predicted` (from MotionPredictor), having driven `distance` in `dt`.
   void predict(const Pose2d& predicted, double distance, double dt);
-  // KF1: a GPS fix (x, y in the local frame, heading) with its covariance (3x3, x y psi).
-  void update_gps(const Eigen::Vector3d& z, const Eigen::Matrix3d& R);
+  // KF1: a GPS fix (x, y in the local frame, heading): z = pose + bias + white noise.
+  void update_gps(const Eigen::Vector3d& z, const GpsErrorModel& gps);
+  // The fix's innovation (z minus pose and bias, the angle wrapped) and its covariance: for gating.
+  Eigen::Vector3d gps_innovation(const Eigen::Vector3d& z) const;
+  Eigen::Matrix3d gps_innovation_covariance(const GpsErrorModel& gps) const;
   // KF2: the curb matching observation (x_c, y_c, psi_c) and the intensity one (x_s, y_s).
   void update_curb(const Eigen::Vector3d& z, const Eigen::Matrix3d& R);
   // J: how the observation moves per radian of error in the heading it was made at (ApsResult's
@@ -71,19 +99,38 @@ class PoseFilter {
   // The intensity observation's component along the unit direction `u` only (z, R and J as above).
   void update_intensity_along(const Eigen::Vector2d& z, const Eigen::Matrix2d& R, const Eigen::Vector2d& u,
                               const Eigen::Vector2d& J = Eigen::Vector2d::Zero());
-  // Uncertainty the motion model does not know about (dead reckoning without CAN): P += Q.
-  void inflate(const Eigen::Matrix3d& Q) { P_ += Q; }
+  // Uncertainty the motion model does not know about (dead reckoning without CAN): P += Q on the pose.
+  void inflate(const Eigen::Matrix3d& Q) { P_.topLeftCorner<3, 3>() += Q; }
+  // The pose put elsewhere by a search (a relocalization; a kidnap). What the search placed has no tie
+  // to the GPS bias, and the bias, whose estimate leant on the old pose, starts over from its stationary
+  // doubt (its estimate is kept). With `keep_along` (a unit direction), the search placed the car only
+  // across it: along it, the filter's doubt and its tie to the bias stay. Cutting that tie while keeping
+  // both doubts would let each next fix shrink both, and a car lost for seconds would end up sure of a
+  // position along the road that no one had measured.
+  void reset_pose(const Pose2d& pose, const Eigen::Matrix3d& covariance,
+                  const std::optional<Eigen::Vector2d>& keep_along = std::nullopt);
 
-  Pose2d pose() const { return {x_.x(), x_.y(), x_.z()}; }
-  const Eigen::Matrix3d& covariance() const { return P_; }
+  // A fault injected from outside (a kidnap): the pose is moved, the filter none the wiser.
+  void displace_to(const Pose2d& pose) { x_.head<3>() = Eigen::Vector3d(pose.x, pose.y, pose.yaw); }
+
+  Pose2d pose() const { return {x_(0), x_(1), x_(2)}; }
+  Eigen::Matrix3d covariance() const { return P_.topLeftCorner<3, 3>(); }
+  Eigen::Vector3d gps_bias() const { return x_.tail<3>(); }
+  Eigen::Matrix3d gps_bias_covariance() const { return P_.bottomRightCorner<3, 3>(); }
 
  private:
   template <int N>
-  void update(const Eigen::Matrix<double, N, 1>& z, const Eigen::Matrix<double, N, N>& R,
-              const Eigen::Matrix<double, N, 3>& H);
-  Eigen::Vector3d x_;  // x, y, psi
-  Eigen::Matrix3d P_;
+  void update(const Eigen::Matrix<double, N, 1>& innovation, const Eigen::Matrix<double, N, N>& R,
+              const Eigen::Matrix<double, N, 6>& H);
+  template <int N>
+  void update_pose(const Eigen::Matrix<double, N, 1>& z, const Eigen::Matrix<double, N, N>& R,
+                   const Eigen::Matrix<double, N, 3>& H);
+  // The bias's prior, the first time a fix arrives: stationary, independent of the pose.
+  void start_bias(const GpsErrorModel& gps);
+  Vector6d x_ = Vector6d::Zero();  // x, y, psi, b_x, b_y, b_psi
+  Matrix6d P_ = Matrix6d::Zero();
   PoseFilterParams params_;
+  std::optional<GpsErrorModel> gps_;  // the bias's model, once a fix has come
 };
 
 }  // namespace lidarloop

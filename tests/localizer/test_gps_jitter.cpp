@@ -1,0 +1,51 @@
+// The receiver's white noise learnt from its fix-to-fix jitter, under a bias that wanders and a jump.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "localizer/gps_jitter.hpp"
+
+namespace lidarloop {
+namespace {
+
+TEST(GpsJitter, RecoversTheWhiteNoiseUnderAWanderingBias) {
+  // Fixes at 10 Hz: a Gauss-Markov bias of 2 m (tau 120 s) plus 0.3 m of white noise per axis, heading
+  // 1.5 deg of bias plus 1 deg white. The bias is 7 times the white noise; the estimate must see only
+  // the white part.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0, 1);
+  const double dt = 0.1, tau = 120, white = 0.3, white_yaw = 0.0175;
+  const double phi = std::exp(-dt / tau), drive = std::sqrt(1 - phi * phi);
+  Eigen::Vector3d bias(2.0, -1.0, 0.026), previous = Eigen::Vector3d::Zero();
+  GpsJitterParams params;
+  params.window = 1000;
+  GpsJitter jitter(params);
+  for (int k = 0; k < 3000; ++k) {
+    bias = phi * bias + drive * Eigen::Vector3d(2.0 * n(rng), 2.0 * n(rng), 0.026 * n(rng));
+    const Eigen::Vector3d error = bias + Eigen::Vector3d(white * n(rng), white * n(rng), white_yaw * n(rng));
+    if (k > 0) jitter.add(error - previous);  // the motion itself cancels against odometry
+    previous = error;
+    if (k == 5) {
+      EXPECT_FALSE(jitter.calibrated());
+    }
+  }
+  ASSERT_TRUE(jitter.calibrated());
+  EXPECT_NEAR(std::sqrt(jitter.white_variance().x()), white, 0.03 * white + 0.01);
+  EXPECT_NEAR(std::sqrt(jitter.white_variance().z()), white_yaw, 0.05 * white_yaw);
+}
+
+TEST(GpsJitter, AJumpIsNotTakenForJitter) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n(0, 0.3);
+  GpsJitter jitter;
+  for (int k = 0; k < 200; ++k) jitter.add(Eigen::Vector3d(n(rng), n(rng), 0.01 * n(rng)));
+  const Eigen::Vector3d before = jitter.white_variance();
+  jitter.add(Eigen::Vector3d(4.0, -3.0, 0));  // multipath: 5 m at once
+  EXPECT_EQ(jitter.white_variance(), before);
+  jitter.add(Eigen::Vector3d(std::nan(""), 0, 0));
+  EXPECT_EQ(jitter.white_variance(), before);
+}
+
+}  // namespace
+}  // namespace lidarloop
