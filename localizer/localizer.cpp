@@ -880,8 +880,10 @@ void Localizer::move_to(const Relocation& found) {
     const double yaw_variance = (found.heading ? new_vehicle : old_vehicle)(2, 2);
     covariance = R * Eigen::Vector3d(old_vehicle(0, 0), new_vehicle(1, 1), yaw_variance).asDiagonal() * R.transpose();
   }
-  const Eigen::Vector2d forward(std::cos(found.pose.yaw), std::sin(found.pose.yaw));
-  filter_->reset_pose(found.pose, covariance, found.longitudinal ? std::nullopt : std::optional(forward));
+  UnplacedAxes unplaced;
+  if (!found.longitudinal)
+    unplaced = {Eigen::Vector2d(std::cos(found.pose.yaw), std::sin(found.pose.yaw)), !found.heading};
+  filter_->reset_pose(found.pose, covariance, unplaced);
   if (!found.longitudinal) return;  // still lost: the next scan searches again, narrower across
   lost_.found();
   judge_gps_jump(found.pose);

@@ -71,10 +71,9 @@ void PoseFilter::start_bias(const GpsErrorModel& gps) {
   P_.bottomLeftCorner<3, 3>().setZero();
 }
 
-void PoseFilter::reset_pose(const Pose2d& pose, const Eigen::Matrix3d& covariance,
-                            const std::optional<Eigen::Vector2d>& keep_along) {
-  // In a frame whose first axis is `keep_along` (any, without it), for the pose and the bias alike.
-  const Eigen::Vector2d u = keep_along.value_or(Eigen::Vector2d::UnitX()).normalized();
+void PoseFilter::reset_pose(const Pose2d& pose, const Eigen::Matrix3d& covariance, const UnplacedAxes& unplaced) {
+  // In a frame whose first axis is `along` (any, without it), for the pose and the bias alike.
+  const Eigen::Vector2d u = unplaced.along.value_or(Eigen::Vector2d::UnitX()).normalized();
   Eigen::Matrix3d to_frame = Eigen::Matrix3d::Identity();
   to_frame.topLeftCorner<2, 2>() << u.x(), u.y(), -u.y(), u.x();
   Matrix6d T = Matrix6d::Zero();
@@ -84,10 +83,14 @@ void PoseFilter::reset_pose(const Pose2d& pose, const Eigen::Matrix3d& covarianc
   Matrix6d P = Matrix6d::Zero();
   P.topLeftCorner<3, 3>() = to_frame * covariance * to_frame.transpose();
   if (gps_) P.bottomRightCorner<3, 3>() = to_frame * gps_->bias_variance.asDiagonal() * to_frame.transpose();
-  if (keep_along) {
-    for (int i : {0, 3})
-      for (int j : {0, 3}) P(i, j) = old(i, j);
-  }
+  // Each unplaced axis with its bias (along: 0 and 3; heading: 2 and 5); the search's covariance says
+  // how the axes go together.
+  auto keep = [&](int axis) {
+    for (int i : {axis, axis + 3})
+      for (int j : {axis, axis + 3}) P(i, j) = old(i, j);
+  };
+  if (unplaced.along) keep(0);
+  if (unplaced.heading) keep(2);
   P_ = T.transpose() * P * T;
   x_.head<3>() = Eigen::Vector3d(pose.x, pose.y, pose.yaw);
 }

@@ -13,7 +13,8 @@
 // looks at the car and pull it to the bias within seconds. Carried as a first-order Gauss-Markov state
 // (the standard GNSS error state: Groves, Principles of GNSS, Inertial, and Multisensor Integrated
 // Navigation Systems, 2nd ed., 2013), the bias is learnt wherever the map pins the pose, and a fix
-// then says only what its white noise allows.
+// then says only what its white noise allows. A GpsErrorModel without bias variance leaves the bias at
+// zero: the paper's filter on [x, y, psi], each fix white noise (the localizer's default).
 #include <cstdint>
 #include <optional>
 
@@ -71,6 +72,13 @@ struct GpsErrorModel {
 // [I, -J] (J: ApsResult::yaw_coupling; zero for a match that does not depend on the heading).
 Eigen::Matrix<double, 2, 3> intensity_observation_matrix(const Eigen::Vector2d& J);
 
+// What a search that relocalizes the car did not place: the position along `along` (a unit direction),
+// the heading.
+struct UnplacedAxes {
+  std::optional<Eigen::Vector2d> along;
+  bool heading = false;
+};
+
 class PoseFilter {
  public:
   using Vector6d = Eigen::Matrix<double, 6, 1>;
@@ -101,15 +109,12 @@ class PoseFilter {
                               const Eigen::Vector2d& J = Eigen::Vector2d::Zero());
   // Uncertainty the motion model does not know about (dead reckoning without CAN): P += Q on the pose.
   void inflate(const Eigen::Matrix3d& Q) { P_.topLeftCorner<3, 3>() += Q; }
-  // The pose put elsewhere by a search (a relocalization; a kidnap). What the search placed has no tie
-  // to the GPS bias, and the bias, whose estimate leant on the old pose, starts over from its stationary
-  // doubt (its estimate is kept). With `keep_along` (a unit direction), the search placed the car only
-  // across it: along it, the filter's doubt and its tie to the bias stay. Cutting that tie while keeping
-  // both doubts would let each next fix shrink both, and a car lost for seconds would end up sure of a
-  // position along the road that no one had measured.
-  void reset_pose(const Pose2d& pose, const Eigen::Matrix3d& covariance,
-                  const std::optional<Eigen::Vector2d>& keep_along = std::nullopt);
-
+  // The pose put elsewhere by a search (a relocalization). What the search placed has no tie to the
+  // GPS bias, and the bias on that axis, whose estimate leant on the old pose, starts over from its
+  // stationary doubt (its estimate is kept). What it did not place keeps the filter's doubt and its tie
+  // to the bias: cutting that tie while keeping both doubts would let each next fix shrink both, and a
+  // car lost for seconds would end up sure of a position along the road that no one had measured.
+  void reset_pose(const Pose2d& pose, const Eigen::Matrix3d& covariance, const UnplacedAxes& unplaced = UnplacedAxes());
   // A fault injected from outside (a kidnap): the pose is moved, the filter none the wiser.
   void displace_to(const Pose2d& pose) { x_.head<3>() = Eigen::Vector3d(pose.x, pose.y, pose.yaw); }
 

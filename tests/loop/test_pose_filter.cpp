@@ -157,7 +157,7 @@ TEST(PoseFilter, ASearchThatPlacesTheCarOnlyAcrossTheRoadLeavesItsPlaceAlongTheR
   for (int scan = 0; scan < 50; ++scan) {
     for (int fix = 0; fix < 2; ++fix) filter.update_gps(Eigen::Vector3d(1, 0.5, 0), gps);
     const Eigen::Matrix3d placed = Eigen::Vector3d(filter.covariance()(0, 0), 0.01, 1e-5).asDiagonal();
-    filter.reset_pose({filter.pose().x, 0.0, 0.0}, placed, Eigen::Vector2d::UnitX());
+    filter.reset_pose({filter.pose().x, 0.0, 0.0}, placed, {Eigen::Vector2d::UnitX(), false});
   }
   EXPECT_GT(filter.covariance()(0, 0), 0.9 * 4.0);
   EXPECT_NEAR(filter.covariance()(1, 1), 0.01, 1e-12);
