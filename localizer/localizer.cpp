@@ -283,7 +283,14 @@ void Localizer::on_gps(const GpsFix& fix) {
     }
     return;
   }
-  last_fix_ = {Pose2d{p.x(), p.y(), filter_->pose().yaw}, R};
+  if (n.bias_state && filter_->has_gps_bias()) {
+    // Where the fix puts the car once its learnt bias is taken off, as sure as that bias is known.
+    const Eigen::Vector3d bias = filter_->gps_bias();
+    last_fix_ = {Pose2d{p.x() - bias.x(), p.y() - bias.y(), filter_->pose().yaw},
+                 filter_->gps_bias_covariance() + Eigen::Matrix3d(gps_error_model(reported).white_variance.asDiagonal())};
+  } else {
+    last_fix_ = {Pose2d{p.x(), p.y(), filter_->pose().yaw}, R};
+  }
   const Eigen::Vector2d innovation = p - xy(filter_->pose());
   const bool stepped = gps_steps_.step(fix.stamp_ns, innovation);
   const double sigma = gps_steps_.noise_sigma_m();

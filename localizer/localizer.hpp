@@ -244,7 +244,8 @@ class Localizer {
   // Set while the GPS is rejected (kGpsRejected): the innovation level it had before it jumped.
   std::optional<Eigen::Vector2d> gps_fault_level_;
   // The relocalization's hypotheses: the filter as it was when it became lost (none after a cold start),
-  // and the newest fix (rear axle, the filter's heading; the receiver's own variances).
+  // and the newest fix (rear axle, the filter's heading; the receiver's own variances, or with the bias a
+  // state, less the bias and with its doubt).
   struct PoseBelief {
     Pose2d pose;
     Eigen::Matrix3d covariance;

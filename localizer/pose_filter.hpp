@@ -120,6 +120,7 @@ class PoseFilter {
 
   Pose2d pose() const { return {x_(0), x_(1), x_(2)}; }
   Eigen::Matrix3d covariance() const { return P_.topLeftCorner<3, 3>(); }
+  bool has_gps_bias() const { return gps_.has_value(); }  // a fix has come
   Eigen::Vector3d gps_bias() const { return x_.tail<3>(); }
   Eigen::Matrix3d gps_bias_covariance() const { return P_.bottomRightCorner<3, 3>(); }
 
