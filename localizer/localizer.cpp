@@ -286,8 +286,9 @@ void Localizer::on_gps(const GpsFix& fix) {
   if (n.bias_state && filter_->has_gps_bias()) {
     // Where the fix puts the car once its learnt bias is taken off, as sure as that bias is known.
     const Eigen::Vector3d bias = filter_->gps_bias();
-    last_fix_ = {Pose2d{p.x() - bias.x(), p.y() - bias.y(), filter_->pose().yaw},
-                 filter_->gps_bias_covariance() + Eigen::Matrix3d(gps_error_model(reported).white_variance.asDiagonal())};
+    last_fix_ = {
+        Pose2d{p.x() - bias.x(), p.y() - bias.y(), filter_->pose().yaw},
+        filter_->gps_bias_covariance() + Eigen::Matrix3d(gps_error_model(reported).white_variance.asDiagonal())};
   } else {
     last_fix_ = {Pose2d{p.x(), p.y(), filter_->pose().yaw}, R};
   }
