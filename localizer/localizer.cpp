@@ -268,8 +268,7 @@ void Localizer::on_gps(const GpsFix& fix) {
   if (!filter_) {
     // A cold start: lost until the map has pinned the pose down.
     // One fix is as good as the receiver says; a scale is for the correlation between many.
-    filter_ = PoseFilter::from_gps_fix(z, n.bias_state ? gps_error_model(reported) : white_gps(reported, 1.0),
-                                       params_.filter);
+    filter_ = PoseFilter::from_gps_fix(z, gps_error_model(reported), params_.filter);
     last_fix_ = {filter_->pose(), R};
     lost_.start_search();
     trusted_.reset();
@@ -283,17 +282,27 @@ void Localizer::on_gps(const GpsFix& fix) {
     }
     return;
   }
-  if (n.bias_state && filter_->has_gps_bias()) {
-    // Where the fix puts the car once its learnt bias is taken off, as sure as that bias is known.
+  const Eigen::Vector2d innovation = p - xy(filter_->pose());
+  const bool stepped = gps_steps_.step(fix.stamp_ns, innovation);
+  if (n.bias_state && !gps_fault_level_ && !stepped && previous &&
+      double(fix.stamp_ns - previous->stamp_ns) / kNsPerS <= params_.health.gps_timeout_s) {
+    // The change since the previous fix less the car's motion by odometry (turned into the local frame
+    // by the filter's heading): two fixes' white noise.
+    const Pose2d moved = relative(previous->odometry, odometry_);
+    const Eigen::Vector2d travelled = Eigen::Rotation2Dd(filter_->pose().yaw) * Eigen::Vector2d(moved.x, moved.y);
+    gps_jitter_.add(Eigen::Vector3d(z.x() - previous->z.x() - travelled.x(), z.y() - previous->z.y() - travelled.y(),
+                                    wrap_angle(z.z() - previous->z.z() - moved.yaw)));
+  }
+  const GpsErrorModel own = gps_error_model(reported);
+  if (filter_->has_gps_bias()) {
+    // Where the fix puts the car once its learnt bias is taken off (none without bias_state), as sure
+    // as that bias is known.
     const Eigen::Vector3d bias = filter_->gps_bias();
-    last_fix_ = {
-        Pose2d{p.x() - bias.x(), p.y() - bias.y(), filter_->pose().yaw},
-        filter_->gps_bias_covariance() + Eigen::Matrix3d(gps_error_model(reported).white_variance.asDiagonal())};
+    last_fix_ = {Pose2d{p.x() - bias.x(), p.y() - bias.y(), filter_->pose().yaw},
+                 filter_->gps_bias_covariance() + Eigen::Matrix3d(own.white_variance.asDiagonal())};
   } else {
     last_fix_ = {Pose2d{p.x(), p.y(), filter_->pose().yaw}, R};
   }
-  const Eigen::Vector2d innovation = p - xy(filter_->pose());
-  const bool stepped = gps_steps_.step(fix.stamp_ns, innovation);
   const double sigma = gps_steps_.noise_sigma_m();
   if (gps_fault_level_) {
     // Rejected until the jump ends: a fix that steps back to the level it had before.
@@ -303,17 +312,9 @@ void Localizer::on_gps(const GpsFix& fix) {
     }
     return;
   }
-  if (!stepped && previous && double(fix.stamp_ns - previous->stamp_ns) / kNsPerS <= params_.health.gps_timeout_s) {
-    // The change since the previous fix less the car's motion by odometry (turned into the local frame
-    // by the filter's heading): two fixes' white noise.
-    const Pose2d moved = relative(previous->odometry, odometry_);
-    const Eigen::Vector2d travelled = Eigen::Rotation2Dd(filter_->pose().yaw) * Eigen::Vector2d(moved.x, moved.y);
-    gps_jitter_.add(Eigen::Vector3d(z.x() - previous->z.x() - travelled.x(), z.y() - previous->z.y() - travelled.y(),
-                                    wrap_angle(z.z() - previous->z.z() - moved.yaw)));
-  }
   // With the bias a state: which part of the error is white is not known before the jitter is.
   if (n.bias_state && !gps_jitter_.calibrated()) return;
-  const GpsErrorModel model = n.bias_state ? gps_error_model(reported) : white_gps(reported, n.variance_scale);
+  const GpsErrorModel model = n.bias_state ? own : white_gps(reported, n.variance_scale);
   if (lost_.lost()) {
     // Lost: the filter itself moves, so steps say nothing new; only the fixes that stepped before (the
     // GPS may be what jumped) wait for the map's verdict.
@@ -323,8 +324,7 @@ void Localizer::on_gps(const GpsFix& fix) {
   // The fix against the filter's pose and bias (with the receiver's own variance, not the scaled one),
   // or a step.
   const Eigen::Vector2d nu = filter_->gps_innovation(z).head<2>();
-  const Eigen::Matrix2d S =
-      filter_->gps_innovation_covariance(n.bias_state ? model : white_gps(reported, 1.0)).topLeftCorner<2, 2>();
+  const Eigen::Matrix2d S = filter_->gps_innovation_covariance(own).topLeftCorner<2, 2>();
   if (stepped || nu.dot(S.ldlt().solve(nu)) > params_.health.gate_gps) {
     if (stepped && gps_steps_.level()) {
       gps_stepped_ = true;
@@ -336,10 +336,11 @@ void Localizer::on_gps(const GpsFix& fix) {
   filter_->update_gps(z, model);  // KF1
 }
 
-// The receiver's stationary variance split into white noise (as its jitter shows it, never more than
-// the whole) and the bias, the rest.
+// The receiver's error as it reports it (its stationary variance): as white noise, or with bias_state
+// split into white noise (as its jitter shows it, never more than the whole) and the bias, the rest.
 GpsErrorModel Localizer::gps_error_model(const Eigen::Vector3d& reported) const {
   const GpsNoise& n = params_.gps_noise;
+  if (!n.bias_state) return white_gps(reported, 1.0);
   GpsErrorModel m;
   m.white_variance = gps_jitter_.white_variance().cwiseMin(reported);
   m.bias_variance = reported - m.white_variance;

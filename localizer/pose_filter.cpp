@@ -63,8 +63,6 @@ PoseFilter PoseFilter::from_gps_fix(const Eigen::Vector3d& z, const GpsErrorMode
 }
 
 void PoseFilter::start_bias(const GpsErrorModel& gps) {
-  if (gps_) return;
-  gps_ = gps;
   x_.tail<3>().setZero();
   P_.bottomRightCorner<3, 3>() = gps.bias_variance.asDiagonal();
   P_.topRightCorner<3, 3>().setZero();
@@ -158,7 +156,7 @@ Eigen::Matrix3d PoseFilter::gps_innovation_covariance(const GpsErrorModel& gps) 
 }
 
 void PoseFilter::update_gps(const Eigen::Vector3d& z, const GpsErrorModel& gps) {
-  start_bias(gps);
+  if (!gps_) start_bias(gps);
   gps_ = gps;  // the receiver's word on its stationary error may change from fix to fix
   Eigen::Matrix<double, 3, 6> H;
   H << Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity();
