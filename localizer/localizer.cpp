@@ -269,7 +269,7 @@ void Localizer::on_gps(const GpsFix& fix) {
     // A cold start: lost until the map has pinned the pose down.
     // One fix is as good as the receiver says; a scale is for the correlation between many.
     filter_ = PoseFilter::from_gps_fix(z, gps_error_model(reported), params_.filter);
-    last_fix_ = {filter_->pose(), R};
+    last_fix_ = {filter_->pose(), R, odometry_};
     lost_.start_search();
     trusted_.reset();
     // The map's intensity tiles where the first scans will read them (S's reach and the wide search's),
@@ -299,9 +299,9 @@ void Localizer::on_gps(const GpsFix& fix) {
     // as that bias is known.
     const Eigen::Vector3d bias = filter_->gps_bias();
     last_fix_ = {Pose2d{p.x() - bias.x(), p.y() - bias.y(), filter_->pose().yaw},
-                 filter_->gps_bias_covariance() + Eigen::Matrix3d(own.white_variance.asDiagonal())};
+                 filter_->gps_bias_covariance() + Eigen::Matrix3d(own.white_variance.asDiagonal()), odometry_};
   } else {
-    last_fix_ = {Pose2d{p.x(), p.y(), filter_->pose().yaw}, R};
+    last_fix_ = {Pose2d{p.x(), p.y(), filter_->pose().yaw}, R, odometry_};
   }
   const double sigma = gps_steps_.noise_sigma_m();
   if (gps_fault_level_) {
@@ -792,7 +792,9 @@ void Localizer::agree(const Pose2d& prior, bool along, bool across) {
   lost_.agree(along, across, position_sigma());
   if (!lost_.lost()) {
     if (was_lost) {
-      // Found and confirmed: the GPS's level is learnt anew against the pose now trusted.
+      // Found and confirmed (perhaps by the narrow matchers while a search ran): the search ends, and
+      // the GPS's level is learnt anew against the pose now trusted.
+      relocalizer_.finish();
       judge_gps_jump(filter_->pose());
       gps_steps_.restart();
       search_sigmas_.setZero();
@@ -810,7 +812,7 @@ void Localizer::disagree(const Eigen::Vector2d& innovation, bool gps) {
     if (lost_.searching()) widen_to(lost_.disagreements(time_ns_));
     return;
   }
-  trusted_ = {filter_->pose(), filter_->covariance()};
+  trusted_ = {filter_->pose(), filter_->covariance(), odometry_};
   lost_by_gps_ = false;
   for (const Disagreement& d : lost_.disagreements(time_ns_)) lost_by_gps_ = lost_by_gps_ || d.gps;
   // Only the GPS disagrees and the map's matches still agree: first see whether they go on agreeing
@@ -849,8 +851,16 @@ void Localizer::relocalize(IntensityGrid* S, LocalizerEstimate& e) {
   // The map's curbs around the car only when there are curbs to search with (match_curbs cuts its own).
   const LocalCurbs local =
       curbs_world.empty() ? LocalCurbs{MapIndex({}), {}} : local_curbs(map_.curbs, xy(prior), params_.map_window_m);
-  const std::optional<Relocation> found =
-      relocalizer_.step(uses_intensity(params_.method) ? S : nullptr, map_.intensity, curbs_world, local.index, prior);
+  const std::optional<Relocation> found = relocalizer_.step(uses_intensity(params_.method) ? S : nullptr,
+                                                            map_.intensity, curbs_world, local.index, prior, odometry_);
+  // A place across the road where the filter already is, is no news: moving there would restart the
+  // search, and with it the other matcher's unfinished search or a whole place waiting to be found
+  // again (curbs place the car across the road every other scan; APS's search takes several).
+  if (found && !found->longitudinal) {
+    const Pose2d change = relative(prior, found->pose);
+    const RelocalizationParams& r = params_.relocalization;
+    if (std::abs(change.y) <= r.confirm_distance_m && std::abs(change.yaw) <= r.confirm_yaw_deg / kDegPerRad) return;
+  }
   if (found) move_to(*found);
 }
 
@@ -861,24 +871,35 @@ void Localizer::start_relocalization() {
   auto half = [&](double sigma, double max_range) {
     return std::clamp(r.window_sigmas * sigma, std::min(r.min_range_m, max_range), max_range);
   };
-  const Eigen::Vector3d ranges(half(sigmas.x(), r.max_longitudinal_m), half(sigmas.y(), r.max_lateral_m),
-                               std::min(r.window_sigmas * sigmas.z(), r.max_yaw_deg / kDegPerRad));
+  const Eigen::Vector3d ranges(
+      half(sigmas.x(), r.max_longitudinal_m), half(sigmas.y(), r.max_lateral_m),
+      // at least a coarse step either side: a peak is on the window's edge beyond half
+      // of one, so a narrower window would refuse every place not at the prior's heading
+      std::clamp(r.window_sigmas * sigmas.z(), r.aps.coarse_yaw_step_rad, r.max_yaw_deg / kDegPerRad));
   // The filter before it was lost, and the newest GPS fix; a cold start has only the filter as the
   // GPS set it up.
   std::vector<Hypothesis> hypotheses;
-  if (trusted_) hypotheses.push_back({trusted_->pose, vehicle_sigmas(trusted_->covariance, trusted_->pose)});
+  auto hypothesis = [&](const PoseBelief& belief) {
+    const PoseBelief now = carried(belief);
+    hypotheses.push_back({now.pose, vehicle_sigmas(now.covariance, now.pose)});
+  };
+  if (trusted_) hypothesis(*trusted_);
   // The GPS is a hypothesis of its own after a cold start or when it disagreed too; not when it has
   // jumped or gone stale, nor when only the map disagreed (the GPS then agrees with the filter, and its
   // metres of doubt would only let the map's ambiguities in).
   if (last_fix_ && (!trusted_ || lost_by_gps_) && !gps_fault_level_ && !(input_health(time_ns_) & kNoGps))
-    hypotheses.push_back({last_fix_->pose, vehicle_sigmas(last_fix_->covariance, last_fix_->pose)});
+    hypothesis(*last_fix_);
   if (hypotheses.empty()) hypotheses.push_back({prior, sigmas});
-  relocalizer_.start(ranges, hypotheses);
+  relocalizer_.start(ranges, hypotheses, odometry_);
 }
 
 void Localizer::move_to(const Relocation& found) {
   relocalizer_.stop();
-  search_sigmas_.setZero();
+  // What the search placed is no longer in doubt; the position along the road, if it was not placed,
+  // is as doubtful as before, and the next search spans it again.
+  search_sigmas_.tail<2>().setZero();
+  if (found.longitudinal) search_sigmas_.x() = 0;
+  if (!found.heading) search_sigmas_.z() = params_.relocalization.lost_yaw_sigma_deg / kDegPerRad;
   Eigen::Matrix3d covariance = found.covariance;
   if (!found.longitudinal) {
     // The filter's doubt along the road stays; across it and in heading, the search's.
@@ -898,6 +919,17 @@ void Localizer::move_to(const Relocation& found) {
   judge_gps_jump(found.pose);
 }
 
+// Moved by the odometry since, with the doubt the filter's prediction adds over that distance.
+Localizer::PoseBelief Localizer::carried(const PoseBelief& belief) const {
+  const Pose2d moved = relative(belief.odometry, odometry_);
+  const double distance = std::hypot(moved.x, moved.y);
+  const PoseFilterParams& q = params_.filter;
+  const double position = q.position_per_sqrt_m * q.position_per_sqrt_m * distance;
+  const double yaw = q.yaw_per_sqrt_m * q.yaw_per_sqrt_m * distance;
+  return {belief.pose.compose(moved),
+          belief.covariance + Eigen::Vector3d(position, position, yaw).asDiagonal().toDenseMatrix(), odometry_};
+}
+
 // Who jumped, once the map has placed the car? If it is about where the filter had it before it was
 // lost while the GPS had stepped, the GPS did. A step away from the filter is a fault: the fixes are
 // rejected until they step back. A step towards it ends one the detector had not caught (a jump that
@@ -906,7 +938,7 @@ void Localizer::move_to(const Relocation& found) {
 void Localizer::judge_gps_jump(const Pose2d& placed) {
   const std::optional<Eigen::Vector2d>& before = gps_steps_.level();
   if (gps_stepped_ && trusted_ && last_gps_step_ && before &&
-      (xy(placed) - xy(trusted_->pose)).norm() < 0.5 * last_gps_step_->norm()) {
+      (xy(placed) - xy(carried(*trusted_).pose)).norm() < 0.5 * last_gps_step_->norm()) {
     if ((*before + *last_gps_step_).norm() > before->norm())
       gps_fault_level_ = before;
     else

@@ -246,10 +246,14 @@ class Localizer {
   // The relocalization's hypotheses: the filter as it was when it became lost (none after a cold start),
   // and the newest fix (rear axle, the filter's heading; the receiver's own variances, or with the bias a
   // state, less the bias and with its doubt).
+  // Each is kept with the dead-reckoning pose of its time, and carried to the present by odometry
+  // (carried()) before it is used: the car drives on (10 m in a second) while a search runs.
   struct PoseBelief {
     Pose2d pose;
     Eigen::Matrix3d covariance;
+    Pose2d odometry;
   };
+  PoseBelief carried(const PoseBelief& belief) const;
   std::optional<PoseBelief> trusted_, last_fix_;
   bool lost_by_gps_ = false;                      // the GPS was among the disagreements that made the filter lost
   std::optional<Eigen::Vector2d> last_gps_step_;  // the last step of the fixes from their level

@@ -22,7 +22,10 @@ Pose2d lateral_and_heading(const Pose2d& found, const Pose2d& prior) {
   return found.compose(Pose2d{d.x, 0, 0});
 }
 
-void Relocalizer::start(const Eigen::Vector3d& half_ranges, const std::vector<Hypothesis>& hypotheses) {
+void Relocalizer::start(const Eigen::Vector3d& half_ranges, const std::vector<Hypothesis>& hypotheses,
+                        const Pose2d& odometry) {
+  if (pending_) pending_ = pending_->compose(relative(odometry_, odometry));
+  odometry_ = odometry;
   WideApsParams aps = p_.aps;
   aps.longitudinal_range_m = half_ranges.x();
   aps.lateral_range_m = half_ranges.y();
@@ -32,7 +35,6 @@ void Relocalizer::start(const Eigen::Vector3d& half_ranges, const std::vector<Hy
   curbs.lateral_range_m = half_ranges.y();
   curbs.yaw_range_rad = half_ranges.z();
   aps_ = WideApsSearch(aps);
-  pending_.reset();
   curbs_ = CurbHypothesisSearch(curbs);
   // No hypothesis is sharper than the search can place a pose: a cell and a yaw step.
   hypotheses_ = hypotheses;
@@ -43,8 +45,13 @@ void Relocalizer::start(const Eigen::Vector3d& half_ranges, const std::vector<Hy
 
 std::optional<Relocation> Relocalizer::step(IntensityGrid* S, IntensityMap& intensity,
                                             const std::vector<Eigen::Vector2d>& curbs, const MapIndex& curb_map,
-                                            const Pose2d& prior) {
+                                            const Pose2d& prior, const Pose2d& odometry) {
   if (!active_) return std::nullopt;
+  // Where each hypothesis has the car now: it drove on since the search started.
+  const Pose2d moved = relative(odometry_, odometry);
+  for (Hypothesis& h : hypotheses_) h.centre = h.centre.compose(moved);
+  if (pending_) pending_ = pending_->compose(moved);
+  odometry_ = odometry;
   const bool have_curbs = curbs.size() >= size_t(p_.curbs.min_curbs) && !curb_map.points().empty();
   const bool curbs_now = have_curbs && (!S || curbs_turn_);
   curbs_turn_ = !curbs_turn_;
@@ -63,16 +70,15 @@ std::optional<Relocation> Relocalizer::step(IntensityGrid* S, IntensityMap& inte
       aps_.restart();
     }
   }
-  return confirmed(found, prior);
+  return confirmed(found);
 }
 
-std::optional<Relocation> Relocalizer::confirmed(const std::optional<Relocation>& found, const Pose2d& prior) {
+std::optional<Relocation> Relocalizer::confirmed(const std::optional<Relocation>& found) {
   if (!found || !found->longitudinal) return found;
-  const Pose2d correction = found->pose.compose(prior.inverse());
   const bool again = pending_ &&
-                     std::hypot(correction.x - pending_->x, correction.y - pending_->y) <= p_.confirm_distance_m &&
-                     std::abs(wrap_angle(correction.yaw - pending_->yaw)) <= p_.confirm_yaw_deg / kDegPerRad;
-  pending_ = correction;
+                     std::hypot(found->pose.x - pending_->x, found->pose.y - pending_->y) <= p_.confirm_distance_m &&
+                     std::abs(wrap_angle(found->pose.yaw - pending_->yaw)) <= p_.confirm_yaw_deg / kDegPerRad;
+  pending_ = found->pose;
   if (!again) return std::nullopt;
   pending_.reset();
   return found;

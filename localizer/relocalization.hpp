@@ -14,7 +14,7 @@
 //     unless for APS the prior (the GPS) alone rules the other place out;
 //     The localizer stays lost then, and searches again from the corrected pose.
 // Anything else is refused, and the search starts again on the next scans. A whole place is taken only
-// when two searches in a row find it (as the same correction of the moving prior, within
+// when two searches in a row find it (the same place, carried with the car by odometry, within
 // confirm_distance_m and confirm_yaw_deg): a wrong place that one scan's paint favours (worn or
 // repainted lines) seldom wins twice.
 #include <optional>
@@ -80,25 +80,35 @@ class Relocalizer {
 
   // A new search around the prior over half ranges (longitudinal m, lateral m, yaw rad; vehicle frame).
   // The places found are weighed by the likelier of the hypotheses (Eq. 14 times a Gaussian prior).
-  void start(const Eigen::Vector3d& half_ranges, const std::vector<Hypothesis>& hypotheses);
+  // `odometry`: the dead-reckoning pose now, by which the hypotheses move with the car from share to share.
+  void start(const Eigen::Vector3d& half_ranges, const std::vector<Hypothesis>& hypotheses, const Pose2d& odometry);
   bool active() const { return active_; }
+  // A search ends; a place found once and waiting to be found again stays (stop) or is dropped (finish:
+  // the localizer is found).
   void stop() { active_ = false; }
+  void finish() {
+    active_ = false;
+    pending_.reset();
+  }
   // One share. `S` (at `prior`, or null), the curb features placed at `prior` (world frame) with the
   // map's curbs around it (or empty). A relocation when a search has finished and found one.
   std::optional<Relocation> step(IntensityGrid* S, IntensityMap& intensity, const std::vector<Eigen::Vector2d>& curbs,
-                                 const MapIndex& curb_map, const Pose2d& prior);
+                                 const MapIndex& curb_map, const Pose2d& prior, const Pose2d& odometry);
 
  private:
   std::optional<Relocation> verdict(const WideApsResult& r, const Pose2d& prior) const;
   std::optional<Relocation> verdict(const CurbHypothesesResult& r, const Pose2d& prior) const;
-  // A whole place found twice in a row passes; the first time it is kept, as a correction of the prior.
-  std::optional<Relocation> confirmed(const std::optional<Relocation>& found, const Pose2d& prior);
+  // A whole place found twice in a row passes; the first time it is kept (moved with the car by
+  // odometry), also across searches restarted meanwhile (the narrow matchers or a search that placed the
+  // car only across the road moved the filter).
+  std::optional<Relocation> confirmed(const std::optional<Relocation>& found);
   std::optional<Pose2d> pending_;
 
   RelocalizationParams p_;
   bool active_ = false;
   bool curbs_turn_ = false;
   std::vector<Hypothesis> hypotheses_;
+  Pose2d odometry_;  // when the hypotheses were last moved
   // Minus the log of the likelier hypothesis's Gaussian at `pose` (up to a constant).
   double prior_term(const Pose2d& pose) const;
   WideApsSearch aps_;
