@@ -14,7 +14,7 @@
 // (the standard GNSS error state: Groves, Principles of GNSS, Inertial, and Multisensor Integrated
 // Navigation Systems, 2nd ed., 2013), the bias is learnt wherever the map pins the pose, and a fix
 // then says only what its white noise allows. A GpsErrorModel without bias variance leaves the bias at
-// zero: the paper's filter on [x, y, psi], each fix white noise (the localizer's default).
+// zero: the paper's filter on [x, y, psi], each fix white noise (gps_noise.bias_state: false).
 #include <cstdint>
 #include <optional>
 
