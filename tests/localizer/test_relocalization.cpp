@@ -44,8 +44,8 @@ std::vector<Eigen::Vector2d> t_junction() {
 }
 
 // The map's curbs seen from `truth`, placed at `prior` (world frame, as the localizer hands them over).
-std::vector<Eigen::Vector2d> features(const std::vector<Eigen::Vector2d>& map, const Pose2d& truth,
-                                      const Pose2d& prior, std::mt19937& rng) {
+std::vector<Eigen::Vector2d> features(const std::vector<Eigen::Vector2d>& map, const Pose2d& truth, const Pose2d& prior,
+                                      std::mt19937& rng) {
   std::normal_distribution<double> noise(0.0, kFeatureNoise);
   std::vector<Eigen::Vector2d> f;
   const Pose2d to_vehicle = truth.inverse();
