@@ -5,6 +5,8 @@
 // minutes). So the fix-to-fix change less odometry's motion has twice the white variance. The rest of
 // the error the receiver reports (its stationary variance) is the slowly wandering bias, which the
 // filter carries as a state (pose_filter.hpp).
+#include <vector>
+
 #include <Eigen/Core>
 
 namespace lidarloop {
@@ -20,7 +22,11 @@ class GpsJitter {
  public:
   explicit GpsJitter(const GpsJitterParams& params = {}) : p_(params) {}
 
-  // One fix-to-fix change less odometry's motion (x, y in m, heading in rad).
+  // One fix-to-fix change less odometry's motion (x, y in m, heading in rad). A jump is refused: beyond
+  // the gates against the running mean once calibrated, and before that against the median of the
+  // changes taken so far (a jump among the first few would otherwise be most of the estimate). So the
+  // caller need not know whether the GPS jumped, which it could only judge against the filter's pose
+  // (and a filter moved by its matches, lost or at a cold start, makes every fix look like a step).
   void add(const Eigen::Vector3d& change);
   bool calibrated() const { return samples_ >= p_.min_samples; }
   // The white variance per fix (x, y pooled: the receiver's horizontal noise is the same both ways;
@@ -31,6 +37,7 @@ class GpsJitter {
   GpsJitterParams p_;
   double xy_ = 0, yaw_ = 0;
   int samples_ = 0;
+  std::vector<Eigen::Vector2d> first_;  // (xy, yaw) of each change taken before calibrated()
 };
 
 }  // namespace lidarloop

@@ -284,7 +284,7 @@ void Localizer::on_gps(const GpsFix& fix) {
   }
   const Eigen::Vector2d innovation = p - xy(filter_->pose());
   const bool stepped = gps_steps_.step(fix.stamp_ns, innovation);
-  if (n.bias_state && !gps_fault_level_ && !stepped && previous &&
+  if (n.bias_state && !gps_fault_level_ && previous &&
       double(fix.stamp_ns - previous->stamp_ns) / kNsPerS <= params_.health.gps_timeout_s) {
     // The change since the previous fix less the car's motion by odometry (turned into the local frame
     // by the filter's heading): two fixes' white noise.
