@@ -24,7 +24,8 @@ class GpsJitter {
 
   // One fix-to-fix change less odometry's motion (x, y in m, heading in rad). A jump is refused: beyond
   // the gates against the running mean once calibrated, and before that against the median of the
-  // changes taken so far (a jump among the first few would otherwise be most of the estimate). So the
+  // changes taken so far, all of which are screened again when there are enough (a jump among the
+  // first few would otherwise be most of the estimate). So the
   // caller need not know whether the GPS jumped, which it could only judge against the filter's pose
   // (and a filter moved by its matches, lost or at a cold start, makes every fix look like a step).
   void add(const Eigen::Vector3d& change);
@@ -35,6 +36,10 @@ class GpsJitter {
 
  private:
   GpsJitterParams p_;
+  // A change (xy, yaw: half its squared size per axis) improbable against these levels of them.
+  bool jump(const Eigen::Vector2d& change, double level_xy, double level_yaw) const;
+  // The mean level of such changes, from their median.
+  static Eigen::Vector2d median_level(const std::vector<Eigen::Vector2d>& changes);
   double xy_ = 0, yaw_ = 0;
   int samples_ = 0;
   std::vector<Eigen::Vector2d> first_;  // (xy, yaw) of each change taken before calibrated()

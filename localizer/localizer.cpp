@@ -196,6 +196,7 @@ Localizer::Localizer(HdMap& map, const LocalizerParams& params)
 
 void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance) {
   predict_to(stamp_ns);
+  relocalizer_.finish();
   filter_.emplace(pose, covariance, params_.filter);
 }
 
@@ -433,7 +434,8 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
 
   // While lost the narrow matchers (their windows grown to the filter's doubt) and the GPS still
   // converge the filter as they can (a search may find nothing for long); the search starts afresh
-  // whenever they move it, since its places are kept relative to the filter.
+  // whenever they move it, since an unfinished search's places are kept relative to the filter (a
+  // place found once waits on, carried by odometry).
   if (lost_.searching()) relocalize(S ? &*S : nullptr, e);
   const Pose2d before = filter_->pose();
   match_and_fuse(S ? &*S : nullptr, e);
