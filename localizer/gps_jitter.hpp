@@ -25,9 +25,9 @@ class GpsJitter {
   // One fix-to-fix change less odometry's motion (x, y in m, heading in rad). A jump is refused: beyond
   // the gates against the running mean once calibrated, and before that against the median of the
   // changes taken so far, all of which are screened again when there are enough (a jump among the
-  // first few would otherwise be most of the estimate). So the
-  // caller need not know whether the GPS jumped, which it could only judge against the filter's pose
-  // (and a filter moved by its matches, lost or at a cold start, makes every fix look like a step).
+  // first few would otherwise be most of the estimate). So the caller need not know whether the GPS
+  // jumped, which it could only judge against the filter's pose (and a filter moved by its matches,
+  // lost or at a cold start, makes every fix look like a step).
   void add(const Eigen::Vector3d& change);
   bool calibrated() const { return samples_ >= p_.min_samples; }
   // The white variance per fix (x, y pooled: the receiver's horizontal noise is the same both ways;

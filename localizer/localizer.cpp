@@ -921,7 +921,8 @@ void Localizer::move_to(const Relocation& found) {
   judge_gps_jump(found.pose);
 }
 
-// Moved by the odometry since, with the doubt the filter's prediction adds over that distance.
+// Moved by the odometry since, with odometry's per-metre doubt over that distance (the filter's random
+// walks per metre; not its per-second term, nor the heading's doubt turned into position by the drive).
 Localizer::PoseBelief Localizer::carried(const PoseBelief& belief) const {
   const Pose2d moved = relative(belief.odometry, odometry_);
   const double distance = std::hypot(moved.x, moved.y);

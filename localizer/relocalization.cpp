@@ -24,8 +24,7 @@ Pose2d lateral_and_heading(const Pose2d& found, const Pose2d& prior) {
 
 void Relocalizer::start(const Eigen::Vector3d& half_ranges, const std::vector<Hypothesis>& hypotheses,
                         const Pose2d& odometry) {
-  if (pending_) pending_ = pending_->compose(relative(odometry_, odometry));
-  odometry_ = odometry;
+  carry(odometry);  // the pending place; the hypotheses are replaced below
   WideApsParams aps = p_.aps;
   aps.longitudinal_range_m = half_ranges.x();
   aps.lateral_range_m = half_ranges.y();
@@ -47,11 +46,7 @@ std::optional<Relocation> Relocalizer::step(IntensityGrid* S, IntensityMap& inte
                                             const std::vector<Eigen::Vector2d>& curbs, const MapIndex& curb_map,
                                             const Pose2d& prior, const Pose2d& odometry) {
   if (!active_) return std::nullopt;
-  // Where each hypothesis has the car now: it drove on since the search started.
-  const Pose2d moved = relative(odometry_, odometry);
-  for (Hypothesis& h : hypotheses_) h.centre = h.centre.compose(moved);
-  if (pending_) pending_ = pending_->compose(moved);
-  odometry_ = odometry;
+  carry(odometry);  // the car drove on since the search started
   const bool have_curbs = curbs.size() >= size_t(p_.curbs.min_curbs) && !curb_map.points().empty();
   const bool curbs_now = have_curbs && (!S || curbs_turn_);
   curbs_turn_ = !curbs_turn_;
@@ -71,6 +66,13 @@ std::optional<Relocation> Relocalizer::step(IntensityGrid* S, IntensityMap& inte
     }
   }
   return confirmed(found);
+}
+
+void Relocalizer::carry(const Pose2d& odometry) {
+  const Pose2d moved = relative(odometry_, odometry);
+  for (Hypothesis& h : hypotheses_) h.centre = h.centre.compose(moved);
+  if (pending_) pending_ = pending_->compose(moved);
+  odometry_ = odometry;
 }
 
 std::optional<Relocation> Relocalizer::confirmed(const std::optional<Relocation>& found) {

@@ -108,7 +108,9 @@ class Relocalizer {
   bool active_ = false;
   bool curbs_turn_ = false;
   std::vector<Hypothesis> hypotheses_;
-  Pose2d odometry_;  // when the hypotheses were last moved
+  // The hypotheses and the pending place moved with the car to where odometry now has it.
+  void carry(const Pose2d& odometry);
+  Pose2d odometry_;  // when they were last moved
   // Minus the log of the likelier hypothesis's Gaussian at `pose` (up to a constant).
   double prior_term(const Pose2d& pose) const;
   WideApsSearch aps_;
