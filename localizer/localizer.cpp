@@ -34,12 +34,13 @@ Eigen::Vector2d xy(const Pose2d& p) { return {p.x, p.y}; }
 double& stage_ms(LocalizerEstimate& e, Stage s) { return e.stage_ms[size_t(s)]; }
 
 // The scan in the vehicle frame at `reference_ns` after its stamp, de-skewed with CAN's motion over
-// the scan unless that is switched off.
+// the scan unless that is switched off, and turned back by the body's roll.
 ScanPoints vehicle_frame_points(const PointCloud& cloud, const LocalizerParams& params, const ScanMotion& motion,
-                                int64_t reference_ns, LocalizerEstimate& e) {
+                                int64_t reference_ns, double body_roll, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::deskew));
   ScanPoints points = params.deskew ? deskew(cloud, params.lidar_mount, motion, reference_ns)
                                     : to_vehicle_frame(cloud, params.lidar_mount);
+  unroll(points.xyz, body_roll, params.body_roll.pivot_height_m);
   e.points = points.size();
   e.dropped_points = points.dropped;
   if (points.dropped > 0) e.health |= kInvalidPoints;
@@ -192,7 +193,8 @@ Localizer::Localizer(HdMap& map, const LocalizerParams& params)
       lost_(params.lost),
       gps_steps_(params.gps_steps),
       gps_jitter_(params.gps_noise.jitter),
-      relocalizer_(params.relocalization) {}
+      relocalizer_(params.relocalization),
+      body_roll_(params.body_roll) {}
 
 void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance) {
   predict_to(stamp_ns);
@@ -215,6 +217,7 @@ void Localizer::predict_to(int64_t t_ns) {
   const Pose2d before = odometry_;
   const double dt = double(t_ns - time_ns_) / kNsPerS;
   odometry_ = predictor_.advance(odometry_, speed_, steer_, t_ns - time_ns_, params_.max_prediction_step_s);
+  body_roll_.step(speed_ * predictor_.yaw_rate(), dt);
   time_ns_ = t_ns;
   if (!filter_) return;
   // The filter moves by the odometry's increment in its own frame.
@@ -396,7 +399,8 @@ void Localizer::process_scan(const PointCloud& cloud, LocalizerEstimate& e) {
   const LocalizerMethod method = params_.method;
   if (method == LocalizerMethod::gps) return;
 
-  const ScanPoints points = vehicle_frame_points(cloud, params_, {speed_, predictor_.yaw_rate()}, scan_ns, e);
+  const ScanPoints points =
+      vehicle_frame_points(cloud, params_, {speed_, predictor_.yaw_rate()}, scan_ns, body_roll_.roll(), e);
   const bool empty = points.size() < size_t(std::max(params_.health.min_scan_points, 1));
   if (empty) e.health |= kEmptyScan;
   if (empty || !filter_) {

@@ -239,6 +239,7 @@ class Localizer {
   };
   std::optional<GpsPair> previous_fix_;
   Relocalizer relocalizer_;
+  BodyRoll body_roll_;                                       // the body's roll from CAN, to unroll the scans
   Eigen::Vector3d search_sigmas_ = Eigen::Vector3d::Zero();  // longitudinal, lateral (m), yaw (rad)
   bool gps_stepped_ = false;  // the GPS's disagreement that made the localizer lost was a step
   // Set while the GPS is rejected (kGpsRejected): the innovation level it had before it jumped.

@@ -249,6 +249,13 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .number("steering_ratio", p.vehicle.steering_ratio, 1.0, 50.0)
       .number("kinematic_below", p.vehicle.kinematic_below, 0.0, 10.0)
       .done();
+  YamlMap(y, top["body_roll"], "body_roll")
+      .boolean("enabled", p.body_roll.enabled)
+      .number("gradient_deg_per_g", p.body_roll.gradient_deg_per_g, 0.0, 90.0)
+      .number("frequency_hz", p.body_roll.frequency_hz, 0.01, 100.0)
+      .number("damping_ratio", p.body_roll.damping_ratio, 0.0, 10.0)
+      .number("pivot_height_m", p.body_roll.pivot_height_m, 0.0, 10.0)
+      .done();
   YamlMap(y, top["filter"], "filter")
       .number("position_per_sqrt_m", p.filter.position_per_sqrt_m, 0.0, 10.0)
       .number("yaw_per_sqrt_m", p.filter.yaw_per_sqrt_m, 0.0, 1.0)

@@ -11,6 +11,7 @@
 #include "common/localizer_method.hpp"
 #include "common/yaml_reader.hpp"
 #include "localizer/aps_matcher.hpp"
+#include "localizer/body_roll.hpp"
 #include "localizer/curb_detector.hpp"
 #include "localizer/curb_features.hpp"
 #include "localizer/curb_match_covariance.hpp"
@@ -141,6 +142,7 @@ struct LocalizerParams {
   // fraction of a uniform spread over the search window's extent on that axis (1 = no information).
   double aps_max_spread_ratio = 0.5;
   VehicleModelParams vehicle;
+  BodyRollParams body_roll;  // beyond the paper: the scan unrolled from the body (body_roll.hpp)
   PoseFilterParams filter;
   double process_position_without_can_per_s = 2.0;  // m per s of dead reckoning without CAN
   CurbMatchNoise curb_noise;
