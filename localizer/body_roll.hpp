@@ -7,11 +7,15 @@
 // match's own error, and the same way all through the bend.
 //
 // The ground plane the scan sees (2.1.2) cannot tell this roll from the road's crown and bank (the car
-// sits on one half of a crowned road), so the roll is predicted from what causes it, the lateral
-// acceleration speed times yaw rate, through the body's roll mode: q'' = -w^2 (q - K a_y / g) - 2 z w q'
-// (the linear roll model of Gillespie, Fundamentals of Vehicle Dynamics, SAE 1992, ch. 8), with the
-// car's roll gradient K, frequency and damping. Pitch under braking moves the road along by under a
-// centimetre at 0.3 g (2 deg/g) and is left out; heave moves only heights, which the ground plane takes.
+// sits on one half of a crowned road), so the roll is predicted from what causes it: the lateral
+// acceleration, Eq. 19's from CAN's speed and steering (MotionPredictor::lateral_acceleration), through
+// the body's roll mode q'' = -w^2 (q - K a_y / g) - 2 z w q' (the linear roll model of Gillespie,
+// Fundamentals of Vehicle Dynamics, SAE 1992, ch. 8), with the car's roll gradient K, frequency and
+// damping. Pitch under braking moves the road along by under a centimetre at 0.3 g (2 deg/g) and is left
+// out; heave moves only heights, which the ground plane takes.
+//
+// One roll per scan, at the scan's reference time (its end), after the de-skew: entering a bend the
+// roll changes 5-10 deg/s, so the scan's first firings are up to 1 deg off, about a centimetre sideways.
 #include <vector>
 
 #include <Eigen/Core>
@@ -25,17 +29,20 @@ struct BodyRollParams {
   // Assumption: roll modes of passenger cars sit a little above bounce (1-1.5 Hz, Gillespie ch. 5).
   double frequency_hz = 1.5;
   double damping_ratio = 0.3;  // Gillespie ch. 5: passenger cars' damping ratios are 0.2-0.4
-  // The height above the ground the body rolls about. NHTSA rollover ratings give SUVs a static
-  // stability factor T / (2 h) of about 1.1-1.2: with a 1.6 m track the centre of mass is ~0.7 m up,
-  // and this car's body model rolls about it.
+  // The height above the ground the body rolls about. A real body rolls about its roll axis, through
+  // the suspensions' roll centres, which lie below the centre of mass (Gillespie ch. 8): a real car's
+  // configuration gives that height here. The simulated car's body model rolls about its centre of
+  // mass, and NHTSA rollover ratings give SUVs a static stability factor T / (2 h) of about 1.1-1.2:
+  // with a 1.6 m track that is ~0.7 m up.
   double pivot_height_m = 0.7;
 };
 
-// The roll mode, stepped with the lateral acceleration CAN implies.
+// The roll mode, stepped with the lateral acceleration.
 class BodyRoll {
  public:
   explicit BodyRoll(const BodyRollParams& params) : p_(params) {}
-  // Advances by dt seconds with lateral acceleration a_y (m/s^2, positive to the left) held.
+  // Advances by dt seconds with lateral acceleration a_y (m/s^2, positive to the left) held. Beyond a
+  // few settling times (a gap in CAN, a log's first message) the mode is at rest at its target.
   void step(double lateral_acceleration, double dt);
   // rad about the vehicle's x axis, positive = left side up (as in a left turn).
   double roll() const { return p_.enabled ? roll_ : 0.0; }

@@ -217,7 +217,7 @@ void Localizer::predict_to(int64_t t_ns) {
   const Pose2d before = odometry_;
   const double dt = double(t_ns - time_ns_) / kNsPerS;
   odometry_ = predictor_.advance(odometry_, speed_, steer_, t_ns - time_ns_, params_.max_prediction_step_s);
-  body_roll_.step(speed_ * predictor_.yaw_rate(), dt);
+  body_roll_.step(predictor_.lateral_acceleration(), dt);
   time_ns_ = t_ns;
   if (!filter_) return;
   // The filter moves by the odometry's increment in its own frame.

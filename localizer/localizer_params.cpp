@@ -252,8 +252,8 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   YamlMap(y, top["body_roll"], "body_roll")
       .boolean("enabled", p.body_roll.enabled)
       .number("gradient_deg_per_g", p.body_roll.gradient_deg_per_g, 0.0, 90.0)
-      .number("frequency_hz", p.body_roll.frequency_hz, 0.01, 100.0)
-      .number("damping_ratio", p.body_roll.damping_ratio, 0.0, 10.0)
+      .number("frequency_hz", p.body_roll.frequency_hz, 0.1, 10.0)
+      .number("damping_ratio", p.body_roll.damping_ratio, 0.01, 2.0)
       .number("pivot_height_m", p.body_roll.pivot_height_m, 0.0, 10.0)
       .done();
   YamlMap(y, top["filter"], "filter")

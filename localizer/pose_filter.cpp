@@ -27,6 +27,7 @@ Pose2d MotionPredictor::predict(const Pose2d& pose, double v, double delta, doub
     // Kinematic bicycle about the rear axle: no slip, yaw rate v tan(delta) / L.
     beta_ = std::atan(p_.lr * std::tan(delta) / L);
     yaw_rate_ = v * std::tan(delta) / L;
+    lateral_acceleration_ = v * yaw_rate_;
   } else {
     // Eq. 19 (Euler): side slip beta and yaw rate at the centre of mass.
     const double cf = kTyresPerAxle * p_.cornering_stiffness_front, cr = kTyresPerAxle * p_.cornering_stiffness_rear;
@@ -36,6 +37,7 @@ Pose2d MotionPredictor::predict(const Pose2d& pose, double v, double delta, doub
     const double yaw_acc = (p_.lf * cf * alpha_f - p_.lr * cr * alpha_r) / p_.yaw_inertia;
     beta_ += beta_dot * dt;
     yaw_rate_ += yaw_acc * dt;
+    lateral_acceleration_ = v * (yaw_rate_ + beta_dot);
   }
   // Lateral velocity of the rear axle in the body frame: none in the kinematic model; with Eq. 19's
   // slip, the centre of mass's v tan(beta) carried back to the axle: v tan(beta) - l_r psi_dot.

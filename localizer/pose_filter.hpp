@@ -42,10 +42,14 @@ class MotionPredictor {
   // The same over dt_ns, in Euler steps of at most max_step_s, v and delta held throughout.
   Pose2d advance(Pose2d pose, double v, double delta, int64_t dt_ns, double max_step_s);
   double yaw_rate() const { return yaw_rate_; }  // rad/s, as of the last step
+  // The centre of mass's lateral acceleration, v (yaw rate + d beta / dt), m/s^2 to the left, as of
+  // the last step: into a bend the tyres' side force comes before the yaw rate has built up.
+  double lateral_acceleration() const { return lateral_acceleration_; }
 
  private:
   VehicleModelParams p_;
   double beta_ = 0, yaw_rate_ = 0;  // Eq. 19's dynamic states
+  double lateral_acceleration_ = 0;
 };
 
 // Process noise as random walks, so that it does not depend on how often predict() is called (CAN at

@@ -28,14 +28,13 @@
 //   cg_height_m              0.7     centre of mass above the ground (the pivot; sets K from a gradient)
 #include <Eigen/Core>
 
+#include "common/units.hpp"
 #include "common/vehicle_messages.hpp"
 #include "common/yaml_reader.hpp"
 #include "sim/realism.hpp"
 #include "sim/vehicle_model.hpp"
 
 namespace lidarloop {
-
-inline constexpr double kGravity = 9.80665;  // m/s^2, standard gravity (ISO 80000-3)
 
 struct BodyConfig {
   bool rigid = false;

@@ -2,6 +2,8 @@
 // gradient times the lateral acceleration, reached as a second-order mode overshoots; and a road seen
 // from a body rolled about its pivot (as the simulator's body model poses it) is put back where it lies.
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -16,7 +18,7 @@ namespace {
 TEST(BodyRoll, ASteadyBendRollsTheBodyByItsGradientAfterTheModesOvershoot) {
   const BodyRollParams params;  // 5 deg/g, 1.5 Hz, damping 0.3
   BodyRoll body(params);
-  const double g = 9.80665, a_y = 0.3 * g;  // a left bend at 0.3 g, from rest
+  const double a_y = 0.3 * kGravity;  // a left bend at 0.3 g, from rest
   double peak = 0;
   for (int k = 0; k < 1000; ++k) {  // 10 s at CAN's 100 Hz
     body.step(a_y, 0.01);
@@ -26,10 +28,16 @@ TEST(BodyRoll, ASteadyBendRollsTheBodyByItsGradientAfterTheModesOvershoot) {
   EXPECT_NEAR(body.roll(), steady, 0.005 * steady);
   // A step into a second-order mode overshoots by exp(-z pi / sqrt(1 - z^2)): 37 % at z = 0.3.
   const double z = params.damping_ratio;
-  EXPECT_NEAR(peak / steady, 1 + std::exp(-z * M_PI / std::sqrt(1 - z * z)), 0.01);
-  // Out of the bend it settles back; a long CAN gap is stepped through, not jumped.
-  body.step(0.0, 10.0);
-  EXPECT_NEAR(body.roll(), 0.0, 1e-3 * steady);
+  EXPECT_NEAR(peak / steady, 1 + std::exp(-z * std::numbers::pi / std::sqrt(1 - z * z)), 0.01);
+  // Out of the bend it swings back through level (the same overshoot) within half a period...
+  BodyRoll leaving = body;
+  leaving.step(0.0, 0.5 / params.frequency_hz);
+  EXPECT_LT(leaving.roll(), -0.2 * steady);
+  // ...and after a long gap in CAN it is at rest, whatever came before.
+  body.step(0.0, 1e9);
+  EXPECT_EQ(body.roll(), 0.0);
+  body.step(std::numeric_limits<double>::quiet_NaN(), 0.01);  // bad input leaves it as it was
+  EXPECT_EQ(body.roll(), 0.0);
 
   BodyRollParams off = params;
   off.enabled = false;
