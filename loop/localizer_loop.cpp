@@ -11,7 +11,9 @@
 #include <thread>
 #include <variant>
 
+#include "loop/fault_events.hpp"
 #include "loop/localizer_backend.hpp"
+#include "loop/scorer.hpp"
 
 namespace lidarloop {
 namespace {
@@ -29,10 +31,10 @@ using Message = std::variant<TruthSample, CanFrame, GpsFix, ScanMessage>;
 class Localizers {
  public:
   Localizers(HdMap& map, const std::vector<LocalizerParams>& methods, const Scenario& scenario, LoopResult& result)
-      : result_(result) {
+      : scenario_(scenario), result_(result) {
     for (const auto& p : methods) {
       localizers_.push_back(std::make_unique<LocalizerBackend>(map, p, scenario));
-      result_.methods.push_back({localizers_.back()->label(), {}, {}});
+      result_.methods.push_back({localizers_.back()->label(), {}, {}, {}});
     }
   }
 
@@ -40,7 +42,10 @@ class Localizers {
   std::optional<LocalizerEstimate> process(const Message& m) {
     const auto t0 = Clock::now();
     std::optional<LocalizerEstimate> primary;
-    if (const auto* t = std::get_if<TruthSample>(&m)) latest_truth_ = t->pose;
+    if (const auto* t = std::get_if<TruthSample>(&m)) {
+      if (!latest_truth_) events_ = fault_events(scenario_, t->stamp_ns);
+      latest_truth_ = t->pose;
+    }
     if (const auto* f = std::get_if<CanFrame>(&m))
       for (auto& l : localizers_) l->on_can(*f);
     if (const auto* f = std::get_if<GpsFix>(&m))
@@ -50,8 +55,11 @@ class Localizers {
         LocalizerEstimate e = localizers_[i]->on_scan(s->cloud);
         MethodTrace& trace = result_.methods[i];
         // The latest truth sample is at most one truth period from the estimate: close enough to pick
-        // the worst frame (the scorer interpolates properly).
-        if (latest_truth_ && !(e.health & kNotInitialized)) {
+        // the worst frame (the scorer interpolates properly), among the frames the scorer rates.
+        if (!trace.first_estimate_ns) trace.first_estimate_ns = e.stamp_ns;
+        if (latest_truth_ && !(e.health & kNotInitialized) &&
+            !settling(e.stamp_ns, *trace.first_estimate_ns, scenario_.pass) &&
+            !recovering(e.stamp_ns, scenario_.pass, events_)) {
           const double error = std::hypot(e.pose.x - latest_truth_->x, e.pose.y - latest_truth_->y);
           if (error > trace.worst.error_m)
             trace.worst = {error, s->cloud, s->sensor_pose, localizers_[i]->last_features(), *latest_truth_, e.pose};
@@ -71,6 +79,8 @@ class Localizers {
 
  private:
   std::vector<std::unique_ptr<LocalizerBackend>> localizers_;
+  const Scenario& scenario_;
+  std::vector<FaultEvent> events_;  // from the first truth sample on
   std::optional<Pose2d> latest_truth_;
   LoopResult& result_;
 };

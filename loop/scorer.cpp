@@ -309,6 +309,21 @@ CurbOcclusion curb_occlusion(const std::vector<CurbVisibility>& scans) {
   return o;
 }
 
+bool settling(int64_t stamp_ns, int64_t first_estimate_ns, const PassThresholds& thresholds) {
+  return double(stamp_ns - first_estimate_ns) < thresholds.settle_s * double(kNsPerS);
+}
+
+// Unset, the recovery criteria's defaults still measure the events, but every frame is scored for
+// accuracy: a scenario that only jumps the GPS means the map to carry the car through the jump.
+bool recovering(int64_t stamp_ns, const PassThresholds& thresholds, const std::vector<FaultEvent>& events) {
+  if (!thresholds.recovery) return false;
+  for (const FaultEvent& event : events)
+    if (event.what != "start" && stamp_ns >= event.stamp_ns &&
+        double(stamp_ns - event.stamp_ns) <= thresholds.recovery->within_s * double(kNsPerS))
+      return true;
+  return false;
+}
+
 ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates, const Path& route,
                 const PassThresholds& thresholds, const std::string& method, const std::string& scenario,
                 const std::vector<FaultEvent>& events, const std::vector<CurbVisibility>& curb_visibility,
@@ -322,17 +337,7 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
   m.scenario = scenario;
   m.thresholds = thresholds;
 
-  // Unset, the recovery criteria's defaults still measure the events, but every frame is scored for
-  // accuracy: a scenario that only jumps the GPS means the map to carry the car through the jump.
   const PassThresholds::Recovery recovery_criteria = thresholds.recovery.value_or(PassThresholds::Recovery{});
-  auto recovering = [&](int64_t t) {
-    if (!thresholds.recovery) return false;
-    for (const FaultEvent& event : events)
-      if (event.what != "start" && t >= event.stamp_ns &&
-          double(t - event.stamp_ns) <= recovery_criteria.within_s * double(kNsPerS))
-        return true;
-    return false;
-  };
 
   std::vector<double> lateral, longitudinal, heading_deg, position, latency;
   std::vector<FrameError> in_range;  // every estimate in the truth's range, settling or not: for recovery
@@ -345,13 +350,13 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
     }
     const FrameError e = estimate_error(truth_at(truth, est.stamp_ns), est);
     in_range.push_back(e);
-    if (double(est.stamp_ns - estimates.front().stamp_ns) < thresholds.settle_s * double(kNsPerS)) {
+    if (settling(est.stamp_ns, estimates.front().stamp_ns, thresholds)) {
       ++m.settling_frames;
       continue;
     }
     run.errors.push_back(e);
     run.estimate_index.push_back(i);
-    if (recovering(e.stamp_ns)) {
+    if (recovering(e.stamp_ns, thresholds, events)) {
       ++m.recovery_frames;
       continue;
     }

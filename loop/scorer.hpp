@@ -184,6 +184,12 @@ struct ScoredRun {
 
 // ---- The scorer ----
 
+// The two kinds of estimate score() keeps out of the RMSEs and the maxima (see Metrics): settling, within
+// thresholds.settle_s of the first estimate; recovering, with thresholds.recovery set, within its
+// within_s after one of `events` other than the start. The run's worst-frame picture uses the same.
+bool settling(int64_t stamp_ns, int64_t first_estimate_ns, const PassThresholds& thresholds);
+bool recovering(int64_t stamp_ns, const PassThresholds& thresholds, const std::vector<FaultEvent>& events);
+
 // Scores every estimate whose stamp lies within the truth's time range and after the settling time
 // (counted from the first estimate, scored or not), and measures the truth's lane keeping along
 // `route`. The estimates are aligned to the truth by time stamp only: the truth is interpolated at

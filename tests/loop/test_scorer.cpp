@@ -79,6 +79,23 @@ std::string read_all(const std::string& path) {
 
 const char* const kUnwritableDir = "/nonexistent_lidarloop_dir";
 
+TEST(RatedFrames, SettlingFromTheFirstEstimateAndRecoveringAfterAFaultButNotTheStart) {
+  // What score() keeps out of its RMSEs and maxima, and the worst-frame picture with it.
+  PassThresholds t;
+  t.settle_s = 2.0;
+  const int64_t s = kNsPerS;
+  EXPECT_TRUE(settling(2 * s + s / 2, s, t));  // 1.5 s after the first estimate
+  EXPECT_FALSE(settling(3 * s, s, t));
+  const std::vector<FaultEvent> events = {{0, "start"}, {8 * s, "kidnap"}};
+  EXPECT_FALSE(recovering(8 * s + s / 2, t, events));  // no recovery criteria: every frame is rated
+  t.recovery = PassThresholds::Recovery{};             // within 3 s
+  EXPECT_TRUE(recovering(8 * s + s / 2, t, events));
+  EXPECT_TRUE(recovering(11 * s, t, events));
+  EXPECT_FALSE(recovering(11 * s + 1, t, events));
+  EXPECT_FALSE(recovering(7 * s, t, events));
+  EXPECT_FALSE(recovering(s, t, events));  // the start is settle_s's
+}
+
 TEST(FrameError, DisplacementAlongHeadingIsLongitudinal) {
   for (double yaw : {0.0, 0.7, kPi / 2, 2.5, -kPi / 2, -3.0}) {
     const Pose2d truth{3, -4, yaw};
