@@ -4,8 +4,6 @@
 #include <cmath>
 #include <numbers>
 
-#include <Eigen/Geometry>
-
 #include "common/units.hpp"
 
 namespace lidarloop {

@@ -34,7 +34,7 @@ class Localizers {
       : scenario_(scenario), result_(result) {
     for (const auto& p : methods) {
       localizers_.push_back(std::make_unique<LocalizerBackend>(map, p, scenario));
-      result_.methods.push_back({localizers_.back()->label(), {}, {}, {}});
+      result_.methods.push_back({localizers_.back()->label(), {}, {}});
     }
   }
 
@@ -56,9 +56,8 @@ class Localizers {
         MethodTrace& trace = result_.methods[i];
         // The latest truth sample is at most one truth period from the estimate: close enough to pick
         // the worst frame (the scorer interpolates properly), among the frames the scorer rates.
-        if (!trace.first_estimate_ns) trace.first_estimate_ns = e.stamp_ns;
-        if (latest_truth_ && !(e.health & kNotInitialized) &&
-            !settling(e.stamp_ns, *trace.first_estimate_ns, scenario_.pass) &&
+        const int64_t first_ns = trace.estimates.empty() ? e.stamp_ns : trace.estimates.front().stamp_ns;
+        if (latest_truth_ && !(e.health & kNotInitialized) && !settling(e.stamp_ns, first_ns, scenario_.pass) &&
             !recovering(e.stamp_ns, scenario_.pass, events_)) {
           const double error = std::hypot(e.pose.x - latest_truth_->x, e.pose.y - latest_truth_->y);
           if (error > trace.worst.error_m)

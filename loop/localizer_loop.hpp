@@ -5,7 +5,6 @@
 // first method's estimate is what the controller steers on (a scan late: see run_localizer_loop).
 #include <functional>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,8 +25,7 @@ struct WorstFrame {
 struct MethodTrace {
   std::string method;
   std::vector<LocalizerEstimate> estimates;
-  WorstFrame worst;                          // of the frames the scorer rates (not settling or recovering)
-  std::optional<int64_t> first_estimate_ns;  // the settling time's start
+  WorstFrame worst;  // of the frames the scorer rates (not settling or recovering)
 };
 
 struct LoopResult {
