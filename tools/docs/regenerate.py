@@ -272,18 +272,55 @@ def bench(r, commands, args):
         raise Failure(f"`{shown}` did not print JSON ({e}); it printed:\n{stdout[:2000]}")
 
 
+def shown_path(path):
+    return os.path.relpath(path, ROOT) if os.path.isabs(path) else path
+
+
+def localizer_table(doc):
+    """bench localizer's JSON as one row per stage, p50 / p99 / max at each thread count."""
+    runs = doc["runs"]
+    head = "| stage | " + " | ".join(f"{run['threads']} thread{'s' if run['threads'] > 1 else ''}: p50 | p99 | max"
+                                    for run in runs) + " |"
+    rule = "|---|" + "---:|---:|---:|" * len(runs)
+
+    def cells(values):
+        return " | ".join(num(values.get(k), "{:.2f}") for k in ("p50", "p99", "max"))
+
+    rows = ["| **total** | " + " | ".join(cells(run["total_ms"]) for run in runs) + " |"]
+    for stage in runs[0]["stages_ms"]:
+        rows.append(f"| {stage} | " + " | ".join(cells(run["stages_ms"][stage]) for run in runs) + " |")
+    rows.append("| scans with a wide search (all scans) | " +
+                " | ".join(cells(run["wide_search_total_ms"]) for run in runs) + " |")
+    timed = ", ".join(f"{run['scans_timed']} scans timed at {run['threads']} thread(s), {run['scans_degraded']} "
+                      f"with a health flag, {run['scans_wide_search']} with a wide search" for run in runs)
+    budget = doc.get("budget_ms", {})
+    return (f"`{shown_path(doc['scenario'])}`, method `{doc['method']}`, {doc['scans']} scans ({timed}); milliseconds per "
+            f"scan after the warm-up scans, against a budget of p50 {budget.get('p50')} ms and p99 "
+            f"{budget.get('p99')} ms:\n\n" + "\n".join([head, rule] + rows) + "\n")
+
+
+def loop_table(doc):
+    rows = ["| loop | wall time s | real-time factor | localizer busy share | scans |", "|---|---:|---:|---:|---:|"]
+    for run in doc["runs"]:
+        rows.append(f"| {run['loop']} | {run['wall_s']:.1f} | {run['realtime_factor']:.2f} | "
+                    f"{run['localizer_busy_share']:.2f} | {run['scans']} |")
+    return (f"`{shown_path(doc['scenario'])}`, method `{doc['method']}`, {doc['simulated_s']:g} s simulated at "
+            f"{doc['threads']} thread(s) (budget: a real-time factor of {doc.get('budget_realtime_factor')}):\n\n" +
+            "\n".join(rows) + "\n")
+
+
 def target_bench(r, commands):
     lidar_commands, localizer_commands = [], []
     lidar = bench(r, lidar_commands, ["lidar", "--scans", "5"])
     localizer = bench(r, localizer_commands, ["localizer", "--duration", "10"])
     loop = bench(r, localizer_commands, ["loop", "--duration", "10"])
     commands += lidar_commands + localizer_commands
-    cores = f"on this machine's {os.cpu_count()} cores, shared with whatever else ran"
+    shared = "on a machine shared with whatever else ran (see the load average above), so read them as rough"
     return {
-        "bench-lidar": (f"`bench lidar` {cores}:\n\n" + json_table(lidar), lidar_commands),
-        "bench-localizer": (f"`bench localizer` {cores} (milliseconds per scan):\n\n" + json_table(localizer) +
-                            f"\n`bench loop` (real-time factor of simulation and localizer together):\n\n" +
-                            json_table(loop), localizer_commands),
+        "bench-lidar": (f"`bench lidar` figures, {shared}:\n\n" + json_table(lidar), lidar_commands),
+        "bench-localizer": (f"`bench localizer` and `bench loop`, {shared}.\n\n" + localizer_table(localizer) +
+                            "\n`bench loop`: simulation and localizer together against the wall clock, in open "
+                            "and in closed loop:\n\n" + loop_table(loop), localizer_commands),
     }
 
 
