@@ -288,7 +288,7 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   // How today's world differs from the surveyed one: applied, and checked, with the world
   // (load_scenario_world), since its positions refer to the world's roads.
   if (const YAML::Node changes = root["world_changes"]) y.expect_map(changes, "world_changes");
-  // The map's survey settings (loop/mapping_drive.hpp's read_survey_options), read with the map.
+  // The map's survey settings (mapping/mapping_drive.hpp's read_survey_options), read with the map.
   if (const YAML::Node survey = root["survey"]) y.expect_map(survey, "survey");
   if (const YAML::Node loop = root["loop"]) s.closed_loop = read_choice(y, loop, "loop", "open", "closed");
   read_pass(y, root["pass"], s.pass);
