@@ -452,15 +452,20 @@ struct Builder {
     for (const auto& [id, s] : map.lines)
       if (s.type == "curbstone" || s.type == "road_border")
         for (const auto& p : s.points) pts.push_back(p.head<2>()), zs.push_back(p.z());
-    const bool any_z = std::any_of(zs.begin(), zs.end(), [](double z) { return z != 0; });
-    if (any_z) {
+    // A map whose bounds mostly carry heights was surveyed in 3-D (its cross-fall is in them too). A
+    // few heights among points without (Karlsruhe's 4 nodes at `ele` 3 among 2,258) are not a terrain:
+    // the reader gives 0 where `ele` is absent, so blending them would raise 3 m hills round them.
+    const bool surveyed = bound_points > 0 && 2 * bound_with_z >= bound_points;
+    const size_t with_z = size_t(std::count_if(zs.begin(), zs.end(), [](double z) { return z != 0; }));
+    if (with_z > 0 && !surveyed)
+      report.warnings.push_back(std::to_string(with_z) + " of " + std::to_string(zs.size()) +
+                                " ground points carry a height, most do not: heights ignored, the ground is level");
+    if (surveyed) {
       auto heights = std::make_shared<const ScatteredHeights>(pts, zs);
       terrain = [heights](const Eigen::Vector2d& p) { return (*heights)(p); };
     } else {
       terrain = [](const Eigen::Vector2d&) { return 0.0; };
     }
-    // A map whose bounds mostly carry heights was surveyed in 3-D: its cross-fall is in them.
-    const bool surveyed = bound_points > 0 && 2 * bound_with_z >= bound_points;
     const double slope = surveyed ? 0.0 : std_.cross_slope, reach = std_.crown_distance;
     std::ostringstream why;
     if (surveyed)
