@@ -143,6 +143,14 @@ struct Lanelet2BuildReport {
   std::string summary() const;  // several lines, for the CLI
 };
 
+// A world's road network from a Lanelet2 map: the map as read, and how to build it.
+struct Lanelet2Source {
+  std::string file;   // the map, as the world names it (resolved against the world file's folder)
+  std::string where;  // the world file's entry, file:line:col, for later errors
+  Lanelet2Map map;
+  Lanelet2WorldParams params;
+};
+
 // Builds the world. actors_dir holds the parked vehicles' meshes (assets/actors). Throws InputError
 // (naming the map file) for a map whose carriageway is empty.
 World build_lanelet2_world(const Lanelet2Map& map, const Lanelet2WorldParams& params, const MaterialTable& materials,

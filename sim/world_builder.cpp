@@ -9,6 +9,7 @@
 #include "common/input_error.hpp"
 #include "sim/actor_assets.hpp"
 #include "sim/curb_band.hpp"
+#include "sim/lanelet2_world.hpp"
 #include "sim/mesh_shapes.hpp"
 #include "sim/polyline.hpp"
 
@@ -377,7 +378,7 @@ struct Builder {
     }
   }
 
-  void build_objects() {
+  void build_buildings() {
     for (const auto& b : desc.buildings) {
       const MaterialId m = materials.id(b.material, b.where);
       const Eigen::Rotation2D<double> rot(b.yaw);
@@ -389,6 +390,10 @@ struct Builder {
       add_box(world.mesh, b.centre.cast<float>(), (b.size / 2).cast<float>(), float(b.yaw), base - 0.3f,
               base + float(b.height), m);
     }
+  }
+
+  void build_objects() {
+    build_buildings();
     const MaterialId metal = mat("metal"), sign = mat("retro_reflector"), leaves = mat("vegetation");
     const region::Paths near_carriageway = region::offset(world.carriageway, 0.5);
     // Street furniture stands closer to the curb than poles and trees: clear of the road by this.
@@ -499,6 +504,10 @@ struct Builder {
         world.curb_kinds.push_back(curb_profile_name(CurbProfile::vertical));
       }
     }
+    build_parked();
+  }
+
+  void build_parked() {
     std::map<std::string, TriangleMesh> meshes;
     for (const auto& v : desc.parked) {
       if (!meshes.count(v.type)) meshes[v.type] = load_actor_mesh(actors_dir, *actor_type_from_name(v.type), materials);
@@ -534,6 +543,17 @@ GroundHeight World::pavement() const {
 
 World build_world(const WorldDescription& description, const MaterialTable& materials, const std::string& actors_dir) {
   Builder b{description, materials, actors_dir, {}, {}};
+  if (description.lanelet2) {
+    // The road network is the map's; what the world file adds stands on it.
+    Lanelet2BuildReport report;
+    b.world =
+        build_lanelet2_world(description.lanelet2->map, description.lanelet2->params, materials, actors_dir, &report);
+    b.world.name = description.name;
+    b.world.import_report = report.summary();
+    b.build_buildings();
+    b.build_parked();
+    return std::move(b.world);
+  }
   b.world.name = description.name;
   b.world.origin = description.origin;
   b.world.surface = std::make_shared<const RoadSurface>(description);
