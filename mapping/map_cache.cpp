@@ -13,10 +13,12 @@
 #include <sstream>
 
 #include <tbb/parallel_invoke.h>
+#include <yaml-cpp/yaml.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "common/input_error.hpp"
+#include "common/path_beside.hpp"
 #include "mapping/file_lock.hpp"
 #include "mapping/survey_plot.hpp"
 #include "sim/world_assets.hpp"
@@ -49,6 +51,29 @@ static void hash_file(uint64_t& h, const std::string& path) {
   hash_bytes(h, s.str());
 }
 
+// The Lanelet2 map a world is made from, and the projector file beside it if there is one: a world.yaml
+// naming a map (`lanelet2: {file}`), or the map itself.
+static std::vector<std::string> lanelet2_files(const std::string& world_path) {
+  std::string map;
+  if (fs::path(world_path).extension() == ".osm") {
+    map = world_path;
+  } else {
+    YAML::Node root;
+    try {
+      root = YAML::LoadFile(world_path);
+    } catch (const YAML::Exception&) {
+      return {};  // loading the world reports what is wrong with its file
+    }
+    if (!root.IsMap() || !root["lanelet2"] || !root["lanelet2"]["file"]) return {};
+    map = path_beside(world_path, root["lanelet2"]["file"].as<std::string>());
+  }
+  std::vector<std::string> files;
+  if (map != world_path) files.push_back(map);
+  const std::string projector = (fs::path(map).parent_path() / "map_projector_info.yaml").string();
+  if (fs::is_regular_file(projector)) files.push_back(projector);
+  return files;
+}
+
 std::string map_cache_root() {
   if (const char* env = std::getenv("LIDARLOOP_MAP_CACHE"); env && *env) return env;
   return std::string(LIDARLOOP_BUILD_DIR) + "/maps";
@@ -58,6 +83,7 @@ std::string map_hash(const std::string& world_name, const MappingOptions& option
   const std::string world_path = world_file(world_name);
   uint64_t h = kFnvOffset;
   hash_file(h, world_path);
+  for (const std::string& file : lanelet2_files(world_path)) hash_file(h, file);
   hash_file(h, data_dir() + "/assets/materials.yaml");
   std::vector<std::string> actors;
   for (const auto& entry : fs::directory_iterator(actors_dir()))

@@ -135,7 +135,7 @@ struct DriveSetup {
 
 std::vector<ActorPlan> oncoming_traffic(const SurveyLane& lane, const MappingOptions& o) {
   std::vector<ActorPlan> traffic;
-  if (!o.traffic || lane.road->one_way) return traffic;
+  if (!o.traffic || !lane.road || lane.road->one_way) return traffic;  // no oncoming lane known on a lanelet chain
   const Path other = lane_path(*lane.road, Lane::right, !lane.backward);
   for (double s = kTrafficSpacing / 2; s < other.length; s += kTrafficSpacing) {
     ActorPlan a;

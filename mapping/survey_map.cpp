@@ -4,6 +4,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "sim/lane_graph.hpp"
+#include "sim/lanelet2_world.hpp"
+
 namespace lidarloop {
 
 namespace {
@@ -35,6 +38,15 @@ SurveyDrive plan_survey(const WorldDescription& d, const SurveyErrorConfig& conf
     drive.length_m += l.path.length;
     drive.lanes.push_back(std::move(l));
   };
+  if (d.lanelet2) {  // a Lanelet2 map: chains of lanelets that together drive every one of them
+    const LaneGraph graph = build_lane_graph(d.lanelet2->map);
+    for (const auto& route : covering_routes(graph)) {
+      SurveyLane l{nullptr, false, make_path(route_centreline(graph, route), false), drive.length_m, {}};
+      for (const auto& p : l.path.points) l.box.extend(p);
+      drive.length_m += l.path.length;
+      drive.lanes.push_back(std::move(l));
+    }
+  }
   for (const auto& road : d.roads) {
     const int per_direction = road.one_way ? road.lanes : std::max(1, road.lanes / 2);
     for (bool backward : {false, true}) {

@@ -14,7 +14,9 @@
 namespace lidarloop {
 
 struct SurveyLane {
-  const RoadSpec* road;  // in the WorldDescription the survey was planned from (which must outlive it)
+  // In the WorldDescription the survey was planned from (which must outlive it); null on a world from
+  // a Lanelet2 map, whose lanes are chains of lanelets.
+  const RoadSpec* road;
   bool backward;
   Path path;
   double start_m;           // distance driven before this lane: the survey error runs on across lanes
@@ -28,7 +30,8 @@ struct SurveyDrive {
 };
 
 // Every lane of every road, right and left lanes of each travel direction that has them (both
-// directions on two-way roads), with the survey error drawn from `rng` over their total length.
+// directions on two-way roads), or on a Lanelet2 map every drivable lanelet (sim/lane_graph.hpp's
+// covering_routes), with the survey error drawn from `rng` over their total length.
 SurveyDrive plan_survey(const WorldDescription& description, const SurveyErrorConfig& config, std::mt19937_64& rng);
 
 // The point of the survey nearest to p, over every lane: the car's true pose there and the distance

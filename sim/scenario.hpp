@@ -25,7 +25,7 @@ namespace lidarloop {
 
 struct PathSpec {
   std::string where;
-  enum class Kind { road, waypoints, crosswalk } kind = Kind::road;
+  enum class Kind { road, waypoints, crosswalk, lanelets } kind = Kind::road;
   // kind == road: a lane of a road
   std::string road;
   Lane lane = Lane::right;
@@ -38,6 +38,10 @@ struct PathSpec {
   // kind == crosswalk: across the road at crosswalk number `crosswalk` of the world
   int crosswalk = -1;
   bool from_left = false;
+  // kind == lanelets, on a world from a Lanelet2 map (sim/lane_graph.hpp): the lanelets in driving
+  // order, or the shortest route between two points
+  std::vector<int64_t> lanelets;
+  std::optional<Eigen::Vector2d> route_from, route_to;
 };
 
 struct TrafficSpec {
