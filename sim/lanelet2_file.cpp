@@ -775,7 +775,7 @@ Lanelet2Map parse(const std::string& xml, const std::string& name, const Lanelet
     Lanelet2LineString line;
     line.id = w.id;
     line.tags = w.tags;
-    line.type = tag(w.tags, "type");
+    line.type = tag(w.tags, "type");  // what a line string is: LinestringTagging.md's type and subtype
     line.subtype = tag(w.tags, "subtype");
     line.where = src.where(w.offset);
     for (const Lanelet2Id ref : w.nodes) {
