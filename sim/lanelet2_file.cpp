@@ -766,13 +766,16 @@ Lanelet2Map parse(const std::string& xml, const std::string& name, const Lanelet
     node_index.emplace(p.node->id, points.size());
     points.emplace_back(xy.x(), xy.y(), p.ele);
   }
-  check_extent(src, placed, points, map.origin, options.max_extent_m);
+  // An MGRS map about its grid square's corner reaches across the square (100 km, the diagonal 141 km)
+  // before its own extent counts.
+  const bool about_corner = !options.origin && projector && projector->type == Lanelet2Coordinates::mgrs;
+  check_extent(src, placed, points, map.origin, options.max_extent_m + (about_corner ? 100'000 * std::sqrt(2.0) : 0));
 
   for (const RawWay& w : file.ways) {
     Lanelet2LineString line;
     line.id = w.id;
     line.tags = w.tags;
-    line.type = tag(w.tags, "type");
+    line.type = tag(w.tags, "type");  // what a line string is: LinestringTagging.md's type and subtype
     line.subtype = tag(w.tags, "subtype");
     line.where = src.where(w.offset);
     for (const Lanelet2Id ref : w.nodes) {
