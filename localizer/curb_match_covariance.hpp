@@ -29,7 +29,7 @@ struct CurbMatchNoise {
   // position's is set from the scenario suite's consistency, not from a source: at 0.03 m this floor
   // alone made the filter claim 2-3 times its lateral error (mean NEES 0.14 on dynamic_campus; 0.84 at
   // 0.01 m). The heading's is the survey's: the map's curbs are placed with the mapping car's heading,
-  // 0.050 deg RMS (Applanix POS LV 220 datasheet, RTK; loop/survey_error.hpp). At 0.115 deg, set like
+  // 0.050 deg RMS (Applanix POS LV 220 datasheet, RTK; mapping/survey_error.hpp). At 0.115 deg, set like
   // the position's, the filter claimed 2.5 times its heading scatter (suite mean heading NEES 0.47;
   // 0.56 at 0.05 deg, misleading frames 0 and 1 of 3694).
   double min_sigma_m = 0.01;

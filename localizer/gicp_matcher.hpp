@@ -73,7 +73,7 @@ struct GicpParams {
   int min_map_points = 1000;
   double min_fitness = 0.5;
   // What no number of scan points can make better: the map itself is off by the survey's pose error
-  // (loop/survey_error.hpp: RTK-INS, 2 cm and 0.05 deg RMS), added to the match's own covariance.
+  // (mapping/survey_error.hpp: RTK-INS, 2 cm and 0.05 deg RMS), added to the match's own covariance.
   double map_sigma_m = 0.02;
   double map_sigma_yaw_rad = 0.05 * 3.14159265358979323846 / 180;
 };

@@ -87,7 +87,7 @@ struct GpsNoise {
 };
 
 // A localizer that is another program, in the loop instead of a built-in method (`exec:PROGRAM ARGS`;
-// loop/external_localizer.hpp runs it). The localizer itself never reads these.
+// external/external_localizer.hpp runs it). The localizer itself never reads these.
 struct ExternalLocalizerParams {
   std::vector<std::string> command;  // program and arguments; empty: a built-in method
   // Per scan, from its first byte sent to the answer: at 10 Hz a later answer arrives after the next

@@ -1,10 +1,10 @@
 #pragma once
-// The moments of a run a localizer must recover from (loop/scorer.hpp's FaultEvent), from its scenario:
+// The moments of a run a localizer must recover from (scoring/scorer.hpp's FaultEvent), from its scenario:
 // the start, each kidnap (`faults:`) and each GPS jump (a multipath zone of `gps.zones`, entered and left).
 #include <cstdint>
 #include <vector>
 
-#include "loop/scorer.hpp"
+#include "scoring/scorer.hpp"
 #include "sim/scenario.hpp"
 
 namespace lidarloop {

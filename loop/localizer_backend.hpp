@@ -1,11 +1,11 @@
 #pragma once
 // One localizer in the loop, whichever kind: a built-in method (localizer/localizer.hpp) or another
-// program (`exec:`, loop/external_localizer.hpp). The loop, replay and compare drive this.
+// program (`exec:`, external/external_localizer.hpp). The loop, replay and compare drive this.
 #include <memory>
 #include <string>
 
 #include "localizer/localizer.hpp"
-#include "loop/external_localizer.hpp"
+#include "external/external_localizer.hpp"
 #include "loop/kidnap_schedule.hpp"
 
 namespace lidarloop {

@@ -13,7 +13,7 @@
 
 #include "loop/fault_events.hpp"
 #include "loop/localizer_backend.hpp"
-#include "loop/scorer.hpp"
+#include "scoring/scorer.hpp"
 
 namespace lidarloop {
 namespace {

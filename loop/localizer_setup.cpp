@@ -4,8 +4,8 @@
 
 #include "common/input_error.hpp"
 #include "loop/kidnap_schedule.hpp"
-#include "loop/map_cache.hpp"
-#include "loop/mapping_drive.hpp"
+#include "mapping/map_cache.hpp"
+#include "mapping/mapping_drive.hpp"
 
 namespace lidarloop {
 

@@ -7,7 +7,7 @@
 
 #include "localizer/hd_map.hpp"
 #include "localizer/localizer_params.hpp"
-#include "loop/mapping_drive.hpp"
+#include "mapping/mapping_drive.hpp"
 #include "sim/scenario.hpp"
 #include "sim/world_assets.hpp"
 

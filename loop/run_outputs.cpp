@@ -1,19 +1,17 @@
 #include "loop/run_outputs.hpp"
 
-#include <unistd.h>
 
-#include <cerrno>
-#include <cstring>
 #include <filesystem>
 #include <sstream>
 
 #include "common/input_error.hpp"
+#include "common/output_dir.hpp"
 #include "localizer/driving_corridor.hpp"
 #include "logs/ros2_messages.hpp"
-#include "loop/birdseye.hpp"
-#include "loop/error_plots.hpp"
+#include "scoring/birdseye.hpp"
+#include "scoring/error_plots.hpp"
 #include "loop/fault_events.hpp"
-#include "loop/result_files.hpp"
+#include "scoring/result_files.hpp"
 #include "sim/sensor_calibration.hpp"
 
 namespace lidarloop {
@@ -41,15 +39,6 @@ void write_worst_frame(const std::string& path, const WorstFrame& w, const HdMap
 }
 
 }  // namespace
-
-void prepare_output_dir(const std::string& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw InputError(dir + ": cannot create the output folder (" + ec.message() + ")");
-  // access() sees a read-only file system and missing permissions (though not, for root, a mode).
-  if (::access(dir.c_str(), W_OK | X_OK) != 0)
-    throw InputError(dir + ": cannot write into the output folder (" + std::strerror(errno) + ")");
-}
 
 std::vector<TruthPose> truth_poses(const std::vector<TruthSample>& truth) {
   std::vector<TruthPose> out;

@@ -6,14 +6,9 @@
 
 #include "localizer/hd_map.hpp"
 #include "loop/localizer_loop.hpp"
-#include "loop/scorer.hpp"
+#include "scoring/scorer.hpp"
 
 namespace lidarloop {
-
-// Creates `dir` (and its parents) for a command's output files and checks that files can be made in
-// it: called before a run, so that an output that cannot be written fails at once, not after the run.
-// InputError naming the folder and the reason otherwise.
-void prepare_output_dir(const std::string& dir);
 
 // The scorer's plain inputs from the loop's records. The truth's stamped poses (the scorer needs no
 // speeds or steering):
@@ -23,7 +18,7 @@ std::vector<TruthPose> truth_poses(const std::vector<TruthSample>& truth);
 // log's Odometry and back), so the run scores what a reader of its log or its TUM export gets.
 std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate>& estimates);
 
-// Scores one method's run with the pure scorer (loop/scorer.hpp: the thresholds and settle time from
+// Scores one method's run with the pure scorer (scoring/scorer.hpp: the thresholds and settle time from
 // the scenario, lane keeping along `route`, coverage by the scenario's LiDAR scan period), then
 // writes its files into `dir`: metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml,
 // errors.png, trajectory.png, and worst_frame.png when `worst` is given (else none). `realism`,

@@ -3,7 +3,7 @@
 #include "common/input_error.hpp"
 #include "logs/tum_file.hpp"
 #include "loop/localizer_setup.hpp"
-#include "loop/map_cache.hpp"
+#include "mapping/map_cache.hpp"
 
 namespace lidarloop {
 namespace {

@@ -52,11 +52,18 @@ RoadSurface::RoadSurface(const WorldDescription& d) : hills_(d.hills) {
     }
   }
   index_ = std::make_unique<PointsKdTree>(&points_);
+  add_roughness(d.geometry);
+}
 
+RoadSurface::RoadSurface(HeightFunction terrain, HeightFunction crown, const WorldGeometryParams& geometry)
+    : terrain_fn_(std::move(terrain)), crown_fn_(std::move(crown)) {
+  add_roughness(geometry);
+}
+
+void RoadSurface::add_roughness(const WorldGeometryParams& g) {
   // Roughness: a random-phase sum of plane waves in random directions whose amplitudes follow the
   // ISO 8608 displacement PSD over the band, in equal steps of log frequency. A profile along any
   // line then has (approximately) the class's spectrum and its RMS.
-  const WorldGeometryParams& g = d.geometry;
   const double psd0 = iso8608_psd(g.roughness_class);
   if (psd0 == 0) return;
   std::mt19937_64 rng(g.roughness_seed);
@@ -77,6 +84,7 @@ RoadSurface::RoadSurface(const WorldDescription& d) : hills_(d.hills) {
 RoadSurface::~RoadSurface() = default;
 
 double RoadSurface::terrain(const Eigen::Vector2d& p) const {
+  if (terrain_fn_) return terrain_fn_(p);
   double z = 0;
   for (const Hill& h : hills_) {
     const double r = (p - h.centre).norm();
@@ -94,6 +102,7 @@ double RoadSurface::roughness(const Eigen::Vector2d& p) const {
 // The nearest centreline sample, preferring a road the point lies beside over one whose end it lies
 // beyond: where a road ends on another (a T-junction), the curb across its end belongs to the other.
 RoadPoint RoadSurface::nearest_road(const Eigen::Vector2d& p) const {
+  if (!index_) return {};
   std::array<uint32_t, kNearestCandidates> idx{};
   std::array<double, kNearestCandidates> d2{};
   const size_t found = index_->tree.knnSearch(p.data(), kNearestCandidates, idx.data(), d2.data());
@@ -122,6 +131,7 @@ RoadPoint RoadSurface::nearest_road(const Eigen::Vector2d& p) const {
 // Each road's crown falls linearly from its centreline, or is banked through a curve; where roads meet,
 // the highest of their surfaces is the pavement, so the surface stays continuous through intersections.
 double RoadSurface::crown(const Eigen::Vector2d& p) const {
+  if (crown_fn_) return crown_fn_(p);
   std::array<uint32_t, kNearestSamples> idx{};
   std::array<double, kNearestSamples> d2{};
   const size_t found = index_->tree.knnSearch(p.data(), kNearestSamples, idx.data(), d2.data());

@@ -29,6 +29,11 @@ struct RoadPoint {
 class RoadSurface {
  public:
   explicit RoadSurface(const WorldDescription& description);
+  // A surface given by functions instead of road centrelines (a Lanelet2 map's, sim/lanelet2_world.hpp):
+  // terrain and crown as the functions say, roughness as `geometry`'s ISO 8608 class; it has no roads,
+  // so nearest_road() finds none.
+  using HeightFunction = std::function<double(const Eigen::Vector2d&)>;
+  RoadSurface(HeightFunction terrain, HeightFunction crown, const WorldGeometryParams& geometry);
   ~RoadSurface();
   RoadSurface(const RoadSurface&) = delete;
   RoadSurface& operator=(const RoadSurface&) = delete;
@@ -57,6 +62,8 @@ class RoadSurface {
   std::vector<Sample> samples_;
   std::unique_ptr<PointsKdTree> index_;
   std::vector<Wave> waves_;
+  HeightFunction terrain_fn_, crown_fn_;  // set by the second constructor only
+  void add_roughness(const WorldGeometryParams& geometry);
 };
 
 // Height of whatever a wheel or a foot stands on at a point.

@@ -1,10 +1,15 @@
 #include "sim/scenario.hpp"
 
 #include <cmath>
+#include <limits>
 
+#include "common/input_error.hpp"
 #include "common/localizer_method.hpp"
+#include "common/path_beside.hpp"
 #include "common/units.hpp"
 #include "common/yaml_reader.hpp"
+#include "sim/lane_graph.hpp"
+#include "sim/lanelet2_world.hpp"
 #include "sim/region.hpp"
 
 namespace lidarloop {
@@ -72,8 +77,11 @@ PathSpec read_path(const YamlReader& y, const YAML::Node& n, const char* what) {
   PathSpec p;
   p.where = m.where();
   const YAML::Node road = m["road"], waypoints = m["waypoints"], crosswalk = m["crosswalk"];
-  if (int(bool(road)) + int(bool(waypoints)) + int(bool(crosswalk)) != 1)
-    y.fail(n, std::string(what) + " needs exactly one of 'road', 'waypoints' or 'crosswalk'");
+  // On a Lanelet2 map: the lanelets to drive, or a place to drive to (from `from`).
+  const YAML::Node lanelets = m["lanelets"], to = m["to"];
+  if (int(bool(road)) + int(bool(waypoints)) + int(bool(crosswalk)) + int(bool(lanelets)) + int(bool(to)) != 1)
+    y.fail(n,
+           std::string(what) + " needs exactly one of 'road', 'waypoints', 'crosswalk', 'lanelets' or 'from' and 'to'");
   const YAML::Node lane = m["lane"], direction = m["direction"], offset = m["offset"];
   if (road) {
     p.kind = PathSpec::Kind::road;
@@ -93,6 +101,19 @@ PathSpec read_path(const YamlReader& y, const YAML::Node& n, const char* what) {
     for (size_t i = 1; i < p.waypoints.size(); ++i)
       if ((p.waypoints[i] - p.waypoints[i - 1]).norm() < 0.01) y.fail(waypoints[i], "repeated waypoint");
     m.number("smoothing_radius", p.smoothing_radius, 0.0, 500.0).boolean("closed", p.closed);
+  }
+  if (lanelets) {
+    p.kind = PathSpec::Kind::lanelets;
+    y.expect_sequence(lanelets, "lanelets");
+    for (const auto& id : lanelets)
+      p.lanelets.push_back(
+          y.integer_in(id, "a lanelet id", std::numeric_limits<long>::min(), std::numeric_limits<long>::max()));
+    if (p.lanelets.empty()) y.fail(lanelets, "a route needs at least one lanelet");
+  }
+  if (to) {
+    p.kind = PathSpec::Kind::lanelets;
+    p.route_from = y.vec2(m.required("from"), "from");
+    p.route_to = y.vec2(to, "to");
   }
   if (crosswalk) {
     p.kind = PathSpec::Kind::crosswalk;
@@ -288,7 +309,7 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   // How today's world differs from the surveyed one: applied, and checked, with the world
   // (load_scenario_world), since its positions refer to the world's roads.
   if (const YAML::Node changes = root["world_changes"]) y.expect_map(changes, "world_changes");
-  // The map's survey settings (loop/mapping_drive.hpp's read_survey_options), read with the map.
+  // The map's survey settings (mapping/mapping_drive.hpp's read_survey_options), read with the map.
   if (const YAML::Node survey = root["survey"]) y.expect_map(survey, "survey");
   if (const YAML::Node loop = root["loop"]) s.closed_loop = read_choice(y, loop, "loop", "open", "closed");
   read_pass(y, root["pass"], s.pass);
@@ -308,6 +329,19 @@ Path build_path(const PathSpec& p, const WorldDescription& d) {
       Polyline2d corners = p.waypoints;
       if (p.closed && (corners.front() - corners.back()).norm() < 0.01) corners.pop_back();
       return make_path(fillet_polyline(corners, p.smoothing_radius, p.closed, 3 * kDeg), p.closed);
+    }
+    case PathSpec::Kind::lanelets: {
+      if (!d.lanelet2)
+        throw InputError(p.where + ": a route by lanelets needs a world from a Lanelet2 map; world '" + d.name +
+                         "' has roads");
+      const LaneGraph graph = build_lane_graph(d.lanelet2->map);
+      try {
+        const std::vector<LaneGraphNodeId> route =
+            p.route_to ? shortest_route(graph, *p.route_from, *p.route_to) : route_from_lanelets(graph, p.lanelets);
+        return make_path(route_centreline(graph, route), false);
+      } catch (const InputError& e) {
+        throw InputError(p.where + ": " + e.what());
+      }
     }
     case PathSpec::Kind::crosswalk: {
       if (p.crosswalk >= int(d.crosswalks.size()))
@@ -332,7 +366,12 @@ void check_on_network(const Path& path, const region::Paths& area, const std::st
 }  // namespace
 
 Scenario load_scenario(const std::string& path, const VehicleParams& vehicle, std::optional<Realism> realism) {
-  return parse(YamlReader::open(path), vehicle, realism);
+  Scenario s = parse(YamlReader::open(path), vehicle, realism);
+  // A world given as a file is found beside the scenario, from whatever folder lidarloop runs in; a
+  // world's name (maps/<name>/) stays a name.
+  if (s.world.find('/') != std::string::npos || s.world.ends_with(".yaml") || s.world.ends_with(".osm"))
+    s.world = path_beside(path, s.world);
+  return s;
 }
 Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle,
                         std::optional<Realism> realism) {

@@ -25,7 +25,7 @@ namespace lidarloop {
 
 struct PathSpec {
   std::string where;
-  enum class Kind { road, waypoints, crosswalk } kind = Kind::road;
+  enum class Kind { road, waypoints, crosswalk, lanelets } kind = Kind::road;
   // kind == road: a lane of a road
   std::string road;
   Lane lane = Lane::right;
@@ -38,6 +38,10 @@ struct PathSpec {
   // kind == crosswalk: across the road at crosswalk number `crosswalk` of the world
   int crosswalk = -1;
   bool from_left = false;
+  // kind == lanelets, on a world from a Lanelet2 map (sim/lane_graph.hpp): the lanelets in driving
+  // order, or the shortest route between two points
+  std::vector<int64_t> lanelets;
+  std::optional<Eigen::Vector2d> route_from, route_to;
 };
 
 struct TrafficSpec {
@@ -78,11 +82,11 @@ struct PassThresholds {
   // Estimates in the first settle_s seconds (from the first estimate) are not scored: the localizer
   // starts from one GPS fix that may be metres off, and its convergence is not its accuracy.
   double settle_s = 0;
-  // The least share of the truth's time span the estimates must cover (loop/scorer.hpp's coverage):
+  // The least share of the truth's time span the estimates must cover (scoring/scorer.hpp's coverage):
   // an estimate that starts late, stops early or has gaps is scored on what exists, and this says
   // how much must exist.
   std::optional<double> min_coverage;
-  // Integrity and consistency (loop/scorer.hpp defines each figure). The alert limits are what a
+  // Integrity and consistency (scoring/scorer.hpp defines each figure). The alert limits are what a
   // protection bound must stay under for its frame to count as available.
   std::optional<double> max_misleading_fraction, min_availability;
   double alert_limit_lateral_m = kLocalStreetAlertLimit_m, alert_limit_longitudinal_m = kLocalStreetAlertLimit_m;

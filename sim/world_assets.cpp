@@ -4,6 +4,8 @@
 #include <filesystem>
 
 #include "common/input_error.hpp"
+#include "sim/lane_graph.hpp"
+#include "sim/lanelet2_world.hpp"
 #include "sim/path.hpp"
 #include "sim/scenario.hpp"
 
@@ -18,7 +20,8 @@ std::string actors_dir() { return data_dir() + "/assets/actors"; }
 
 std::string world_file(const std::string& name_or_path) {
   namespace fs = std::filesystem;
-  if (name_or_path.find('/') != std::string::npos || fs::path(name_or_path).extension() == ".yaml") {
+  const std::string extension = fs::path(name_or_path).extension().string();
+  if (name_or_path.find('/') != std::string::npos || extension == ".yaml" || extension == ".osm") {
     if (!fs::is_regular_file(name_or_path)) throw InputError(name_or_path + ": no such world file");
     return name_or_path;
   }
@@ -29,7 +32,9 @@ std::string world_file(const std::string& name_or_path) {
 
 LoadedWorld load_world(const std::string& name_or_path) {
   MaterialTable materials = MaterialTable::load(data_dir() + "/assets/materials.yaml");
-  WorldDescription description = load_world_description(world_file(name_or_path));
+  const std::string file = world_file(name_or_path);
+  WorldDescription description = std::filesystem::path(file).extension() == ".osm" ? lanelet2_world_description(file)
+                                                                                   : load_world_description(file);
   World world = build_world(description, materials, actors_dir());
   return {std::move(materials), std::move(description), std::move(world)};
 }
@@ -50,6 +55,12 @@ LoadedWorld load_scenario_world(const Scenario& scenario) {
 }
 
 Eigen::Isometry3d default_start_pose(const WorldDescription& description, double s) {
+  if (description.lanelet2) {  // the longest of the routes the mapping drive takes
+    const LaneGraph graph = build_lane_graph(description.lanelet2->map);
+    const auto routes = covering_routes(graph);
+    if (routes.empty()) throw InputError(description.lanelet2->file + ": the map has no lanelet a car can drive");
+    return to_isometry(make_path(route_centreline(graph, routes.front()), false).pose_at(s));
+  }
   return to_isometry(lane_path(description.roads.front(), Lane::right, false).pose_at(s));
 }
 

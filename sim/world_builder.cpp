@@ -9,6 +9,8 @@
 #include "common/input_error.hpp"
 #include "sim/actor_assets.hpp"
 #include "sim/curb_band.hpp"
+#include "sim/lanelet2_world.hpp"
+#include "sim/mesh_shapes.hpp"
 #include "sim/polyline.hpp"
 
 namespace lidarloop {
@@ -18,7 +20,6 @@ constexpr double kGroundTile = 8.0;       // m; verge triangles are at most this
 constexpr double kVergeSquare = 4.0;      // m; verge squares sample the terrain's hills this densely
 constexpr double kRoadTile = 0.5;         // m; pavement and sidewalks: crown, roughness, ramps
 constexpr double kCurbStation = 0.5;      // m between cross-sections of the curb band
-constexpr double kPaintPiece = 0.5;       // m; paint is draped over the pavement in pieces this long
 constexpr double kIntersectionPad = 2.0;  // m beyond the corner radius where lane paint stops
 constexpr double kCrosswalkPad = 1.0;     // m before a crosswalk where lane paint stops
 // Work zones. Cones: MUTCD (2009) 6F.64, at least 28 in (0.71 m) tall; for night use a 6 in (0.15 m)
@@ -148,61 +149,12 @@ void add_hedge(TriangleMesh& mesh, const std::vector<const CurbStation*>& run, b
     for (uint32_t k = 2; k + 1 <= kN; ++k) mesh.add_triangle(end + 1, end + k, end + (k + 1) % kN, m);
 }
 
-// A quad of paint (or grass) draped `height` above the ground: split along its length into pieces,
-// each corner at the ground's height there.
-template <class Ground>
-void add_paint_quad(TriangleMesh& mesh, const Eigen::Vector2d& centre, const Eigen::Vector2d& along, double half_length,
-                    double half_width, const Ground& ground, double height, MaterialId m) {
-  const Eigen::Vector2d u = along.normalized(), v(-u.y(), u.x());
-  const int pieces = std::max(1, int(std::ceil(2 * half_length / kPaintPiece)));
-  const auto base = static_cast<uint32_t>(mesh.vertices.size());
-  for (int k = 0; k <= pieces; ++k)
-    for (double side : {-1.0, 1.0}) {
-      const Eigen::Vector2d p = centre + u * (half_length * (2.0 * k / pieces - 1)) + v * (side * half_width);
-      mesh.vertices.emplace_back(float(p.x()), float(p.y()), float(ground(p) + height));
-    }
-  for (uint32_t k = 0; k < uint32_t(pieces); ++k) {  // vertices 2k (right), 2k + 1 (left)
-    mesh.add_triangle(base + 2 * k, base + 2 * k + 2, base + 2 * k + 3, m);
-    mesh.add_triangle(base + 2 * k, base + 2 * k + 3, base + 2 * k + 1, m);
-  }
-}
-
-// A strip of paint along a polyline.
-template <class Ground>
-void add_paint_line(TriangleMesh& mesh, const Polyline2d& line, double half_width, const Ground& ground, double height,
-                    MaterialId m) {
-  for (size_t i = 1; i < line.size(); ++i) {
-    const Eigen::Vector2d d = line[i] - line[i - 1];
-    if (d.norm() < 1e-4) continue;
-    add_paint_quad(mesh, 0.5 * (line[i] + line[i - 1]), d, 0.5 * d.norm(), half_width, ground, height, m);
-  }
-}
-
-// Splits a line into dashes of `dash` metres separated by `gap` metres.
 // The part of a centreline within length/2 of arc length `at`, sampled every kPaintPiece.
 Polyline2d stretch_of(const Polyline2d& centreline, double at, double length) {
   const double from = std::max(0.0, at - length / 2), to = std::min(polyline_length(centreline), at + length / 2);
   Polyline2d out;
   const int pieces = std::max(1, int(std::ceil((to - from) / kPaintPiece)));
   for (int k = 0; k <= pieces; ++k) out.push_back(sample_polyline(centreline, from + (to - from) * k / pieces).point);
-  return out;
-}
-
-std::vector<Polyline2d> dashes(const Polyline2d& line, double dash, double gap) {
-  std::vector<Polyline2d> out;
-  const double len = polyline_length(line);
-  for (double s = 0; s < len; s += dash + gap) {
-    Polyline2d piece;
-    const double end = std::min(len, s + dash);
-    piece.push_back(sample_polyline(line, s).point);
-    double acc = 0;
-    for (size_t i = 1; i < line.size(); ++i) {
-      acc += (line[i] - line[i - 1]).norm();
-      if (acc > s && acc < end) piece.push_back(line[i]);
-    }
-    piece.push_back(sample_polyline(line, end).point);
-    if (end - s > 0.05) out.push_back(std::move(piece));
-  }
   return out;
 }
 
@@ -426,7 +378,7 @@ struct Builder {
     }
   }
 
-  void build_objects() {
+  void build_buildings() {
     for (const auto& b : desc.buildings) {
       const MaterialId m = materials.id(b.material, b.where);
       const Eigen::Rotation2D<double> rot(b.yaw);
@@ -438,6 +390,10 @@ struct Builder {
       add_box(world.mesh, b.centre.cast<float>(), (b.size / 2).cast<float>(), float(b.yaw), base - 0.3f,
               base + float(b.height), m);
     }
+  }
+
+  void build_objects() {
+    build_buildings();
     const MaterialId metal = mat("metal"), sign = mat("retro_reflector"), leaves = mat("vegetation");
     const region::Paths near_carriageway = region::offset(world.carriageway, 0.5);
     // Street furniture stands closer to the curb than poles and trees: clear of the road by this.
@@ -474,10 +430,8 @@ struct Builder {
       std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> spots;
       row_positions(row, spots, near_carriageway, nullptr);
       for (const auto& [p, t] : spots) {
-        const float base = world.raised_level(p), h = float(row.height), r = float(row.crown_radius);
-        add_frustum(world.mesh, {float(p.x()), float(p.y()), base}, 0.15f, 0.12f, 0.45f * h, 8, leaves);
-        add_frustum(world.mesh, {float(p.x()), float(p.y()), base + 0.35f * h}, 0.3f, r, 0.3f * h, 10, leaves);
-        add_frustum(world.mesh, {float(p.x()), float(p.y()), base + 0.65f * h}, r, 0.3f, 0.35f * h, 10, leaves);
+        add_tree(world.mesh, {float(p.x()), float(p.y()), world.raised_level(p)}, float(row.height),
+                 float(row.crown_radius), leaves);
       }
     }
     // Street furniture by the curb: bollards (steel) and hydrants (painted iron, a cap on top), not in
@@ -550,6 +504,10 @@ struct Builder {
         world.curb_kinds.push_back(curb_profile_name(CurbProfile::vertical));
       }
     }
+    build_parked();
+  }
+
+  void build_parked() {
     std::map<std::string, TriangleMesh> meshes;
     for (const auto& v : desc.parked) {
       if (!meshes.count(v.type)) meshes[v.type] = load_actor_mesh(actors_dir, *actor_type_from_name(v.type), materials);
@@ -585,6 +543,17 @@ GroundHeight World::pavement() const {
 
 World build_world(const WorldDescription& description, const MaterialTable& materials, const std::string& actors_dir) {
   Builder b{description, materials, actors_dir, {}, {}};
+  if (description.lanelet2) {
+    // The road network is the map's; what the world file adds stands on it.
+    Lanelet2BuildReport report;
+    b.world =
+        build_lanelet2_world(description.lanelet2->map, description.lanelet2->params, materials, actors_dir, &report);
+    b.world.name = description.name;
+    b.world.import_report = report.summary();
+    b.build_buildings();
+    b.build_parked();
+    return std::move(b.world);
+  }
   b.world.name = description.name;
   b.world.origin = description.origin;
   b.world.surface = std::make_shared<const RoadSurface>(description);

@@ -34,6 +34,9 @@ struct World {
   std::shared_ptr<const RoadSurface> surface;                 // terrain, crown, roughness
   std::shared_ptr<const RaisedGround> curb_band;              // the curbs' cross-sections
   std::function<float(const Eigen::Vector2d&)> raised_level;  // curb top / sidewalk height at a point
+  // A world imported from a map: what was built of it and what not (sim/lanelet2_world.hpp); empty for
+  // a generated world.
+  std::string import_report;
 
   CurbMap curb_map() const { return {origin, name, curbs, curb_kinds}; }
   // What stands on the world: the pavement on the carriageway, the raised ground elsewhere. The

@@ -2,10 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <optional>
 
+#include "common/input_error.hpp"
+#include "common/path_beside.hpp"
 #include "common/units.hpp"
 #include "common/yaml_reader.hpp"
 #include "sim/actor_assets.hpp"
+#include "sim/lanelet2_world.hpp"
 #include "sim/polyline.hpp"
 
 namespace lidarloop {
@@ -197,16 +202,50 @@ HedgeSpec read_hedge(YamlMap& m, const WorldDescription& w) {
   return h;
 }
 
+// world.yaml's `lanelet2` section: the map (a path relative to the world file) and what the map leaves
+// unsaid (sim/lanelet2_world.hpp's Lanelet2WorldParams).
+std::shared_ptr<const Lanelet2Source> read_lanelet2_source(const YamlReader& y, const YAML::Node& n,
+                                                           const std::optional<Geodetic>& origin,
+                                                           const WorldGeometryParams& geometry) {
+  YamlMap m(y, n, "lanelet2");
+  auto source = std::make_shared<Lanelet2Source>();
+  source->where = m.where();
+  const YAML::Node file = m.required("file");
+  source->file = path_beside(y.file(), y.string(file, "file"));
+  Lanelet2WorldParams& p = source->params;
+  p.geometry = geometry;
+  m.string("country", p.country)
+      .number("parking_occupancy", p.parking_occupancy, 0.0, 1.0)
+      .integer("seed", p.seed, 0, uint64_t(1) << 62)
+      .number("curb_high", p.curb_high, 0.0, 0.5)
+      .number("curb_low", p.curb_low, 0.0, 0.3)
+      .number("cross_slope", p.cross_slope, 0.0, 0.1);
+  m.done();
+  Lanelet2ReadOptions read;
+  read.origin = origin;
+  try {
+    source->map = read_lanelet2(source->file, read);
+  } catch (const InputError& e) {
+    y.fail(file, e.what());
+  }
+  return source;
+}
+
 WorldDescription parse(const YamlReader& y) {
   YamlMap root(y, y.root(), "a world description");
   WorldDescription w;
   w.file = y.file();
   w.name = y.string(root.required("name"), "name");
 
-  YamlMap origin(y, root.required("origin"), "origin");
-  w.origin.lat_deg = y.number_in(origin.required("lat"), "lat", -85.0, 85.0);
-  w.origin.lon_deg = y.number_in(origin.required("lon"), "lon", -180.0, 180.0);
-  origin.number("alt", w.origin.alt_m, -500.0, 9000.0).done();
+  // A Lanelet2 map brings its own road network and, unless `origin` says otherwise, its own origin.
+  const YAML::Node lanelet2 = root["lanelet2"];
+  const YAML::Node origin_node = lanelet2 ? root["origin"] : root.required("origin");
+  if (origin_node) {
+    YamlMap origin(y, origin_node, "origin");
+    w.origin.lat_deg = y.number_in(origin.required("lat"), "lat", -85.0, 85.0);
+    w.origin.lon_deg = y.number_in(origin.required("lon"), "lon", -180.0, 180.0);
+    origin.number("alt", w.origin.alt_m, -500.0, 9000.0).done();
+  }
 
   auto& g = w.geometry;
   YamlMap geometry(y, root["geometry"], "geometry");
@@ -243,9 +282,20 @@ WorldDescription parse(const YamlReader& y) {
   YamlMap road_defaults(y, root["road_defaults"], "road_defaults");
   read_road_properties(road_defaults, defaults);
   road_defaults.done();
-  const YAML::Node roads = root.required("roads");
+  if (lanelet2) {
+    if (root["roads"]) y.fail(root["roads"], "a world has either roads or a lanelet2 map, not both");
+    for (const char* key :
+         {"road_defaults", "crosswalks", "stop_lines", "curb_cuts", "poles", "trees", "bollards", "hydrants", "hedges"})
+      if (root[key])
+        y.fail(root[key],
+               std::string(key) + " are placed along roads; a world from a lanelet2 map takes them from the map");
+    w.lanelet2 =
+        read_lanelet2_source(y, lanelet2, origin_node ? std::optional<Geodetic>(w.origin) : std::nullopt, w.geometry);
+    w.origin = w.lanelet2->map.origin;
+  }
+  const YAML::Node roads = lanelet2 ? YAML::Node(YAML::NodeType::Sequence) : root.required("roads");
   y.expect_sequence(roads, "roads");
-  if (roads.size() == 0) y.fail(roads, "a world needs at least one road");
+  if (roads.size() == 0 && !lanelet2) y.fail(roads, "a world needs at least one road");
   for (const auto& n : roads) {
     RoadSpec road = read_road(y, n, defaults);
     if (w.road(road.name)) y.fail(n["name"], "road name '" + road.name + "' is used twice");
@@ -416,6 +466,18 @@ WorldDescription on_ideal_ground(WorldDescription d) {
 }
 
 WorldDescription load_world_description(const std::string& path) { return parse(YamlReader::open(path)); }
+
+WorldDescription lanelet2_world_description(const std::string& osm_path) {
+  WorldDescription w;
+  w.name = std::filesystem::path(osm_path).stem().string();
+  w.file = osm_path;
+  auto source = std::make_shared<Lanelet2Source>();
+  source->file = source->where = osm_path;
+  source->map = read_lanelet2(osm_path);
+  w.origin = source->map.origin;
+  w.lanelet2 = std::move(source);
+  return w;
+}
 
 WorldDescription parse_world_description(const std::string& yaml_text, const std::string& name) {
   return parse(YamlReader::from_string(yaml_text, name));

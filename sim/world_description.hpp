@@ -3,6 +3,7 @@
 // centrelines in local metres, with curbs, sidewalks, paint, and objects beside the road.
 // Loading validates everything that can be checked without building geometry; every error names the
 // file, line and column.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -178,6 +179,8 @@ struct WorldGeometryParams {
   double max_superelevation = 0.04;
 };
 
+struct Lanelet2Source;  // sim/lanelet2_world.hpp
+
 struct WorldDescription {
   std::string name, file;
   Geodetic origin;
@@ -196,11 +199,16 @@ struct WorldDescription {
   std::vector<ParkedVehicleSpec> parked;
   std::vector<PaintChange> paint_changes;  // a world file has none: see apply_world_changes
   std::vector<ConstructionZone> construction;
+  // The road network read from a Lanelet2 map instead of `roads` (world.yaml's `lanelet2`, or a map
+  // file given as the world): roads, and everything placed along them, are then empty.
+  std::shared_ptr<const Lanelet2Source> lanelet2;
 
   const RoadSpec* road(const std::string& name) const;
 };
 
 WorldDescription load_world_description(const std::string& path);
+// A world that is a Lanelet2 map and nothing else (`lidarloop world MAP.osm`), named after the file.
+WorldDescription lanelet2_world_description(const std::string& osm_path);
 // Today's world: `surveyed` (the world file, as the map was surveyed) changed by a scenario's
 // `world_changes` mapping: parked vehicles gone (their positions) or new, lane paint worn or
 // repainted, construction zones. Errors name the scenario's file:line:col.

@@ -6,7 +6,7 @@
 #include <map>
 
 #include "common/input_error.hpp"
-#include "loop/result_files.hpp"
+#include "scoring/result_files.hpp"
 #include "sim/world_assets.hpp"
 
 namespace lidarloop {

@@ -119,7 +119,8 @@ Command bench_command() {
   return {{"bench",
            "lidarloop bench lidar|map|localizer|loop [--world W] [--threads N] [--scans N] [--cache-tiles N]\n"
            "                [--step M] [--scenario FILE] [--duration S] [--method NAME]",
-           "Measure and print JSON. lidar: HDL-32E scans against bare Embree rtcIntersect1 on the same rays.\n"
+           "Measure the speed of the ray caster, the map, the localizer or the whole loop, and print it as JSON.\n"
+           "lidar: HDL-32E scans against bare Embree rtcIntersect1 on the same rays.\n"
            "map: a localizer's map queries along every road of a built map, and the peak resident set.\n"
            "localizer: a simulated drive replayed into the localizer at 1 and 2 threads; p50/p99 per stage.\n"
            "loop: simulation and localizer in closed loop against the wall clock (real-time factor).",

@@ -13,7 +13,7 @@
 #include "loop/kidnap_schedule.hpp"
 #include "loop/localizer_loop.hpp"
 #include "loop/localizer_setup.hpp"
-#include "loop/scorer.hpp"
+#include "scoring/scorer.hpp"
 #include "tools/commands.hpp"
 #include "tools/scene_setup.hpp"
 

@@ -11,11 +11,12 @@
 
 #include <filesystem>
 
+#include "common/output_dir.hpp"
 #include "common/units.hpp"
 #include "common/yaml_reader.hpp"
 #include "localizer/hd_map.hpp"
-#include "loop/autoware_export.hpp"
-#include "loop/map_cache.hpp"
+#include "mapping/autoware_export.hpp"
+#include "mapping/map_cache.hpp"
 #include "loop/run_outputs.hpp"
 #include "sim/path.hpp"
 #include "sim/world_assets.hpp"

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <optional>
 
+#include "common/output_dir.hpp"
 #include "common/input_error.hpp"
 #include "logs/localizer_status.hpp"
 #include "logs/log_topics.hpp"
@@ -18,9 +19,9 @@
 #include "logs/tum_file.hpp"
 #include "loop/localizer_backend.hpp"
 #include "loop/localizer_setup.hpp"
-#include "loop/map_cache.hpp"
+#include "mapping/map_cache.hpp"
 #include "loop/recorded_log.hpp"
-#include "loop/result_files.hpp"
+#include "scoring/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "loop/run_recording.hpp"
 #include "tools/commands.hpp"

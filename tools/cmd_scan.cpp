@@ -5,7 +5,7 @@
 #include <thread>
 
 #include "common/units.hpp"
-#include "loop/birdseye.hpp"
+#include "scoring/birdseye.hpp"
 #include "tools/commands.hpp"
 #include "tools/ply_file.hpp"
 #include "tools/scene_setup.hpp"

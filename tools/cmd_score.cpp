@@ -1,7 +1,7 @@
 // lidarloop score: the trajectory of a localizer that is not ours (a ROS 2 node, a prototype, a
 // vendor binary), scored against a log recorded by `run --record` or `simulate --record`, with the
 // same metrics, files and verdict as `run` (loop/run_outputs.hpp writes them for both). The
-// estimate is aligned to the truth by time stamp only (loop/scorer.hpp); thresholds are the log's
+// estimate is aligned to the truth by time stamp only (scoring/scorer.hpp); thresholds are the log's
 // scenario's `pass`, then a --pass file's, then each --threshold.
 #include <cmath>
 #include <cstdio>
@@ -12,11 +12,11 @@
 #include "common/units.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/tum_file.hpp"
-#include "loop/estimate_file.hpp"
+#include "scoring/estimate_file.hpp"
 #include "loop/fault_events.hpp"
 #include "loop/localizer_setup.hpp"
 #include "loop/recorded_log.hpp"
-#include "loop/result_files.hpp"
+#include "scoring/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "sim/world_assets.hpp"
 #include "tools/commands.hpp"
@@ -128,8 +128,8 @@ Command score_command() {
            "lidarloop score LOG.mcap --estimate FILE [--topic TOPIC] [--out DIR] [--method LABEL]\n"
            "                      [--pass FILE.yaml] [--threshold KEY=VALUE]...",
            "Score a trajectory from any localizer against a log recorded by `run --record` or\n"
-           "`simulate --record`, as `run` scores its own: the truth interpolated at each estimate's\n"
-           "stamp, no spatial alignment; metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml\n"
+           "`simulate --record`, as `run` scores its own. The truth is interpolated at each estimate's\n"
+           "stamp, with no spatial alignment; metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml\n"
            "and plots to DIR. FILE is a TUM trajectory (t x y z qx qy qz qw) or an MCAP with\n"
            "nav_msgs/msg/Odometry or geometry_msgs/msg/PoseWithCovarianceStamped (CDR, as rosbag2\n"
            "records them). Thresholds: the log's scenario's `pass`, then --pass, then --threshold.\n"

@@ -12,14 +12,14 @@
 
 #include "common/input_error.hpp"
 #include "loop/localizer_setup.hpp"
-#include "loop/map_cache.hpp"
-#include "loop/result_files.hpp"
-#include "loop/sweep_plan.hpp"
-#include "loop/sweep_report.hpp"
+#include "mapping/map_cache.hpp"
+#include "scoring/result_files.hpp"
+#include "sweep/sweep_plan.hpp"
+#include "sweep/sweep_report.hpp"
 #include "sim/world_assets.hpp"
 #include "tools/cluster_render.hpp"
 #include "tools/commands.hpp"
-#include "tools/process_pool.hpp"
+#include "sweep/process_pool.hpp"
 
 namespace lidarloop {
 namespace {

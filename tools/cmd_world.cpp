@@ -2,6 +2,7 @@
 #include <chrono>
 #include <iostream>
 
+#include "sim/lanelet2_world.hpp"
 #include "sim/obj_file.hpp"
 #include "sim/world_assets.hpp"
 #include "tools/commands.hpp"
@@ -20,10 +21,13 @@ static int run_world(const Args& args) {
   std::cout << "world        " << w.world.name << " (" << w.description.file << ")\n"
             << "origin       " << w.world.origin.lat_deg << ", " << w.world.origin.lon_deg << " (WGS-84)\n"
             << "extent       " << size.x() << " m x " << size.y() << " m\n"
-            << "roads        " << w.description.roads.size() << "\n"
+            << (w.description.lanelet2 ? "lanelets     " + std::to_string(w.description.lanelet2->map.lanelets.size())
+                                       : "roads        " + std::to_string(w.description.roads.size()))
+            << "\n"
             << "curb lines   " << w.world.curbs.size() << " (" << curb_length << " m)\n"
             << "triangles    " << w.world.mesh.triangle_count() << "\n"
             << "built in     " << ms << " ms\n";
+  if (!w.world.import_report.empty()) std::cout << w.world.import_report;
   if (auto obj = args.value("obj")) {
     write_obj(*obj, w.world.mesh, w.materials);
     std::cout << "mesh         " << *obj << "\n";
@@ -43,8 +47,9 @@ static int run_world(const Args& args) {
 
 Command world_command() {
   return {{"world",
-           "lidarloop world WORLD [--obj FILE.obj] [--curbs FILE.geojson] [--png FILE.png]",
-           "Build a world (a name under maps/ or a world.yaml path); print its size, export mesh and curbs.",
+           "lidarloop world WORLD|MAP.osm [--obj FILE.obj] [--curbs FILE.geojson] [--png FILE.png]",
+           "Build a world (a name under maps/, a world.yaml path or a Lanelet2 map's .osm); print its size and\n"
+           "what it is made of, export mesh and curbs.",
            {{"obj", "FILE", "write the triangle mesh as Wavefront OBJ (one usemtl group per material)"},
             {"curbs", "FILE", "write the curb map as GeoJSON LineStrings in WGS-84"},
             {"png", "FILE", "write a top view coloured by material, curb lines by kind (with a key)"},

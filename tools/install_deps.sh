@@ -12,6 +12,7 @@ packages=(
   libpolyclipping-dev nlohmann-json3-dev libzstd-dev
   libopen3d-dev
   libosmium2-dev
+  libpugixml-dev
 )
 
 missing=()

@@ -1,6 +1,8 @@
 // lidarloop: the command-line front end. Exit codes: 0 success, 1 a scenario failed its thresholds,
 // 2 bad input or usage, or an output that cannot be written (a missing or read-only folder, a full
 // disk), 3 an internal error.
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -16,12 +18,23 @@ static std::vector<Command> commands() {
           export_command(),  recover_command(), bench_command(),    sweep_command()};
 }
 
+// A command's first sentence, its lines joined: the summary's opening sentence says what the command
+// does, the rest how.
+static std::string first_sentence(const std::string& summary) {
+  std::string text = summary;
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  for (size_t end = text.find(". "); end != std::string::npos; end = text.find(". ", end + 1))
+    if (end + 2 < text.size() && std::isupper(static_cast<unsigned char>(text[end + 2])))
+      return text.substr(0, end + 1);
+  return text;
+}
+
 static void print_usage(std::ostream& out) {
   out << "usage: lidarloop <command> [options]   (lidarloop <command> --help for details)\n\ncommands:\n";
   for (const auto& c : commands()) {
     std::string name = "  " + c.spec.name;
     name.resize(12, ' ');
-    out << name << c.spec.summary.substr(0, c.spec.summary.find('\n')) << "\n";
+    out << name << first_sentence(c.spec.summary) << "\n";
   }
 }
 

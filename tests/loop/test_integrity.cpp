@@ -17,10 +17,10 @@
 
 #include "common/input_error.hpp"
 #include "common/units.hpp"
-#include "loop/error_plots.hpp"
+#include "scoring/error_plots.hpp"
 #include "loop/fault_events.hpp"
-#include "loop/result_files.hpp"
-#include "loop/scorer.hpp"
+#include "scoring/result_files.hpp"
+#include "scoring/scorer.hpp"
 
 namespace lidarloop {
 namespace {

@@ -19,8 +19,8 @@
 #include <osmium/visitor.hpp>
 
 #include "common/little_endian.hpp"
-#include "loop/autoware_export.hpp"
-#include "loop/map_cache.hpp"
+#include "mapping/autoware_export.hpp"
+#include "mapping/map_cache.hpp"
 #include "sim/polyline.hpp"
 #include "sim/world_assets.hpp"
 

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "localizer/hd_map.hpp"
-#include "loop/map_cache.hpp"
+#include "mapping/map_cache.hpp"
 #include "sim/ray_scene.hpp"
 #include "sim/world_assets.hpp"
 

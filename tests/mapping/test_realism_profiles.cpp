@@ -1,0 +1,41 @@
+// Realism profiles as the map sees them: typical is the default survey, ideal a survey that is the world,
+// harsh a worse survey; each its own map in the cache.
+#include <gtest/gtest.h>
+
+#include "mapping/mapping_drive.hpp"
+#include "sim/hdl32e.hpp"
+
+namespace lidarloop {
+namespace {
+
+TEST(RealismProfiles, EachProfileSurveysItsOwnMap) {
+  const MappingOptions ideal = mapping_options_for(Realism::ideal), typical = mapping_options_for(Realism::typical),
+                       harsh = mapping_options_for(Realism::harsh);
+  EXPECT_EQ(typical.describe(), MappingOptions{}.describe());  // typical maps keep the cache key they had
+  EXPECT_EQ(ideal.survey_error.sigma_xy_m, 0.0);
+  EXPECT_EQ(ideal.survey_error.heading_sigma_rad, 0.0);
+  EXPECT_EQ(ideal.survey_unit_serial, Hdl32eConfig{}.unit_serial);  // the car's own unit
+  EXPECT_TRUE(ideal.ideal_ground);
+  EXPECT_GT(harsh.survey_error.sigma_xy_m, typical.survey_error.sigma_xy_m);
+  EXPECT_GT(harsh.survey_error.heading_sigma_rad, typical.survey_error.heading_sigma_rad);
+  EXPECT_NE(ideal.describe(), typical.describe());
+  EXPECT_NE(harsh.describe(), typical.describe());
+}
+
+TEST(RealismProfiles, TheIdealMapsWorldIsOnIdealGround) {
+  const LoadedWorld typical = load_mapped_world("campus", mapping_options_for(Realism::typical));
+  const LoadedWorld ideal = load_mapped_world("campus", mapping_options_for(Realism::ideal));
+  // Campus's loop is crowned at 2 %: 3 m from its centre line the pavement is 6 cm lower, except on
+  // ideal ground, where every road is flat.
+  const GroundHeight typical_ground = typical.world.pavement(), ideal_ground = ideal.world.pavement();
+  double typical_spread = 0, ideal_spread = 0;
+  for (double y : {-3.0, -1.5, 0.0, 1.5, 3.0}) {
+    typical_spread = std::max(typical_spread, std::abs(typical_ground({150, y}) - typical_ground({150, 0})));
+    ideal_spread = std::max(ideal_spread, std::abs(ideal_ground({150, y}) - ideal_ground({150, 0})));
+  }
+  EXPECT_GT(typical_spread, 0.03);
+  EXPECT_LT(ideal_spread, 1e-6);
+}
+
+}  // namespace
+}  // namespace lidarloop
