@@ -174,7 +174,7 @@ Command map_command() {
            "lidarloop map WORLD [--traffic] [--force] [--resolution M] [--speed V] [--realism PROFILE]\n"
            "                    [--survey FILE.yaml] [--export autoware DIR]",
            "Build a world's HD map by a mapping drive over every lane (or find it in the cache): the curb\n"
-           "layer (GeoJSON) and the intensity layer (tiles of per-cell count, mean and variance, Eq. 8).\n"
+           "layer (GeoJSON) and the intensity layer (tiles of per-cell count, mean and variance: equation 8).\n"
            "The map is a survey: scans placed with an RTK-INS pose error, by another HDL-32E unit, and the\n"
            "curbs moved by that error; prints the error and writes survey_error.png beside the map.\n"
            "--export autoware DIR writes the map as Autoware loads it: pointcloud_map.pcd, lanelet2_map.osm\n"

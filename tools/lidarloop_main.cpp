@@ -2,9 +2,9 @@
 // 2 bad input or usage, or an output that cannot be written (a missing or read-only folder, a full
 // disk), 3 an internal error.
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 #include <string>
 
 #include "common/input_error.hpp"
@@ -23,18 +23,30 @@ static std::vector<Command> commands() {
 static std::string first_sentence(const std::string& summary) {
   std::string text = summary;
   std::replace(text.begin(), text.end(), '\n', ' ');
-  for (size_t end = text.find(". "); end != std::string::npos; end = text.find(". ", end + 1))
-    if (end + 2 < text.size() && std::isupper(static_cast<unsigned char>(text[end + 2])))
-      return text.substr(0, end + 1);
-  return text;
+  const size_t end = text.find(". ");
+  return end == std::string::npos ? text : text.substr(0, end + 1);
 }
 
 static void print_usage(std::ostream& out) {
+  constexpr size_t kIndent = 12, kWidth = 100;  // a table of contents that fits a terminal
   out << "usage: lidarloop <command> [options]   (lidarloop <command> --help for details)\n\ncommands:\n";
   for (const auto& c : commands()) {
-    std::string name = "  " + c.spec.name;
-    name.resize(12, ' ');
-    out << name << first_sentence(c.spec.summary) << "\n";
+    std::string line = "  " + c.spec.name;
+    line.resize(kIndent, ' ');
+    std::istringstream words(first_sentence(c.spec.summary));
+    std::string word;
+    size_t column = kIndent;
+    while (words >> word) {
+      if (column > kIndent && column + 1 + word.size() > kWidth) {
+        out << line << "\n";
+        line.assign(kIndent, ' ');
+        column = kIndent;
+      }
+      if (column > kIndent) line += ' ', ++column;
+      line += word;
+      column += word.size();
+    }
+    out << line << "\n";
   }
 }
 

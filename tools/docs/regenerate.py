@@ -359,6 +359,44 @@ def target_sweep(r, commands):
     return {"sweep": "\n".join(body).strip() + "\n"}
 
 
+KARLSRUHE_OSM = "../shared/data/maps/lanelet2/karlsruhe_mapping_example.osm"
+
+
+def target_lanelet2(r, commands):
+    if not os.path.isfile(os.path.join(ROOT, KARLSRUHE_OSM)):
+        raise Failure(f"{KARLSRUHE_OSM} not found: the Karlsruhe map is read from the shared data folder beside the clone")
+    cache = fresh(os.path.join(WORK, "maps-cache-karlsruhe"))
+    env = {"LIDARLOOP_MAP_CACHE": cache}
+    built, world_s, world_mb, shown = r.run(["lidarloop", "world", KARLSRUHE_OSM])
+    commands.append(shown)
+    mapped, map_s, map_mb, shown = r.run(["lidarloop", "map", "maps/karlsruhe/world.yaml"], env=env)
+    commands.append(shown)
+    rows = []
+    for loop in ("open", "closed"):
+        out = fresh(os.path.join(WORK, "karlsruhe", loop))
+        _, _, _, shown = r.run(["lidarloop", "run", "scenarios/karlsruhe.yaml", "--loop", loop, "--out", out],
+                               env=env, ok=(0, 1))
+        commands.append(shown)
+        m = json.loads(read(os.path.join(out, "metrics.json")))
+        rows.append(f"| {loop} | {num(m.get('lateral_rmse_m'))} | {num(m.get('longitudinal_rmse_m'))} | "
+                    f"{num(m.get('heading_rmse_deg'))} | {num(m.get('max_position_error_m'))} | "
+                    f"{'PASS' if m.get('pass') else 'FAIL'} |")
+    out = fresh(os.path.join(WORK, "karlsruhe", "compare"))
+    _, _, _, shown = r.run(["lidarloop", "compare", "scenarios/karlsruhe.yaml", "--methods", "all", "--out", out],
+                           env=env, ok=(0, 1))
+    commands.append(shown)
+    comparison = read(os.path.join(out, "comparison.md")).strip()
+    return {"lanelet2": (
+        f"Reading and building the world took {duration_text(world_s)} of wall time, peak resident memory "
+        f"{world_mb:.0f} MB; what `world` printed:\n\n```text\n{built.strip()}\n```\n\n"
+        f"Its HD map from an empty cache took {duration_text(map_s)}, peak {map_mb:.0f} MB:\n\n"
+        f"```text\n{mapped.strip()}\n```\n\n"
+        f"`scenarios/karlsruhe.yaml` (the proposed method) in open and closed loop:\n\n"
+        f"| loop | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | worst error m | result |\n"
+        f"|---|---:|---:|---:|---:|---|\n" + "\n".join(rows) + "\n\n"
+        f"Every method on the same drive (`compare --methods all`):\n\n{comparison}\n")}
+
+
 TARGETS = {
     # name: (function, {block: page}, what it runs)
     "maps": (target_maps, {"maps": "docs/hd-maps.md"},
@@ -373,6 +411,8 @@ TARGETS = {
               "every scenario of the CI suite with lidarloop run (metrics.json), and the README's picture"),
     "bench": (target_bench, {"bench-lidar": "docs/realism.md", "bench-localizer": "docs/localizer.md"},
               "bench lidar, bench localizer and bench loop (short runs)"),
+    "lanelet2": (target_lanelet2, {"lanelet2": "docs/lanelet2-worlds.md"},
+                 "the Karlsruhe Lanelet2 map: its world, its HD map, its scenario in open and closed loop, compare"),
     "sweep": (target_sweep, {"sweep": "docs/sweeps.md"},
               "a 16-run bus occlusion sweep (tools/docs/bus_occlusion_docs.yaml) and its plots"),
 }
