@@ -35,8 +35,9 @@ constexpr uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3
 // points per cell, means and variances that may differ in the last bit of the stored float (large: 44
 // of its cells' m2 by one ulp; campus: none). 5: the point-cloud layer (points.yaml, points/) for the
 // gicp method. 6: the survey's scans are the points a driver decodes from the HDL-32E's packets (block
-// azimuth on the 0.01 deg grid, 2 mm ranges, the calibration's elevations).
-constexpr int kMapFormatVersion = 6;
+// azimuth on the 0.01 deg grid, 2 mm ranges, the calibration's elevations). 7: Embree's kernels fixed
+// to SSE4.2 (sim/ray_scene.cpp), so a map built on one machine is the map built on any other.
+constexpr int kMapFormatVersion = 7;
 
 static void hash_bytes(uint64_t& h, const std::string& bytes) {
   for (unsigned char c : bytes) h = (h ^ c) * kFnvPrime;
