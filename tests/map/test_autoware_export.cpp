@@ -6,6 +6,7 @@
 #include <unistd.h>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -477,6 +478,29 @@ TEST(Lanelet2Map, CampusIsOneConnectedGraph) {
   std::filesystem::remove(path);
   expect_round_trip(campus.map, campus.world.description, campus.world.world.curb_map(), campus.world.materials,
                     campus.summary);
+}
+
+// The routing check on any Lanelet2 map, e.g. an export of `lidarloop map campus --export autoware DIR`:
+// LIDARLOOP_ROUTING_CHECK=DIR/lanelet2_map.osm; skipped without it. Prints the graph's components and how
+// many lanelets the first lanelet and the worst placed one reach.
+TEST(Lanelet2Map, RoutingCheckOfAFile) {
+  const char* path = std::getenv("LIDARLOOP_ROUTING_CHECK");
+  if (!path) GTEST_SKIP() << "LIDARLOOP_ROUTING_CHECK is not set";
+  const Lanelet2Map map = read_lanelet2(path);
+  const LaneGraph graph = build_lane_graph(map);
+  ASSERT_FALSE(graph.nodes.empty());
+  size_t lanelets = 0;
+  for (const auto& [id, nodes] : graph.nodes_of) lanelets += !nodes.empty();
+  auto reached_lanelets = [&](LaneGraphNodeId from) {
+    std::set<Lanelet2Id> ids;
+    for (const LaneGraphNodeId n : reachable_from(graph, from)) ids.insert(graph.nodes[size_t(n)].lanelet);
+    return ids.size();
+  };
+  size_t worst = lanelets;
+  for (LaneGraphNodeId n = 0; n < LaneGraphNodeId(graph.nodes.size()); ++n) worst = std::min(worst, reached_lanelets(n));
+  std::cout << "[ figures  ] " << path << ": " << lanelets << " drivable lanelets; "
+            << describe_components(lane_graph_components(graph)) << "; from lanelet " << graph.nodes.front().lanelet
+            << " " << reached_lanelets(0) << " of " << lanelets << " reachable; the fewest from any: " << worst << "\n";
 }
 
 }  // namespace
