@@ -6,11 +6,11 @@
 
 #include "common/input_error.hpp"
 #include "common/little_endian.hpp"
+#include "common/output_dir.hpp"
 #include "localizer/intensity_map.hpp"
 #include "localizer/map_files.hpp"
 #include "localizer/point_map.hpp"
 #include "logs/pcd_file.hpp"
-#include "common/output_dir.hpp"
 #include "mapping/survey_map.hpp"
 
 namespace lidarloop {

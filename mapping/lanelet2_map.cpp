@@ -47,7 +47,8 @@ constexpr double kCrosswalkStopLineReach = 10.0;
 // finds a lane's successor (lanelet2_core geometry::follows compares the bounds' end points).
 class OsmDocument {
  public:
-  OsmDocument(const Geodetic& origin, GroundHeight height) : frame_(origin), origin_(origin), height_(std::move(height)) {}
+  OsmDocument(const Geodetic& origin, GroundHeight height)
+      : frame_(origin), origin_(origin), height_(std::move(height)) {}
 
   int64_t way(const Polyline2d& line, const Tags& tags) {
     std::vector<int64_t> refs;
@@ -478,12 +479,12 @@ class MapBuilder {
       const int64_t left = line({a - t * w, b - t * w}, {{"type", "pedestrian_marking"}});
       const int64_t right = line({a + t * w, b + t * w}, {{"type", "pedestrian_marking"}});
       // Crosswalk lanelets are two-way and for pedestrians (Lanelet2 LaneletAndAreaTagging.md).
-      const int64_t lanelet = osm_.relation({way_member(left, "left"), way_member(right, "right")},
-                                            {{"type", "lanelet"},
-                                             {"subtype", "crosswalk"},
-                                             {"location", "urban"},
-                                             {"one_way", "no"},
-                                             {"participant:pedestrian", "yes"}});
+      const int64_t lanelet =
+          osm_.relation({way_member(left, "left"), way_member(right, "right")}, {{"type", "lanelet"},
+                                                                                 {"subtype", "crosswalk"},
+                                                                                 {"location", "urban"},
+                                                                                 {"one_way", "no"},
+                                                                                 {"participant:pedestrian", "yes"}});
       // An OSM polygon is a way tagged area=yes whose last node is not repeated (Lanelet2 OSM format;
       // Autoware's examples of area ways in lanelet2_format_extension.md).
       const Polyline2d poly = across(road, cw.at - cw.width / 2, -half, half);

@@ -396,10 +396,11 @@ Written write_world_map(const std::string& world, const std::function<void(Loade
 // (left and right, in and out of the side road), their ends the lanes' ends. Heights with the origin's
 // altitude, speed limits from each road's design speed.
 TEST(Lanelet2Map, TJunctionTurnsEveryWay) {
-  Written t = write_world_map(std::string(LIDARLOOP_DATA_DIR) + "/tests/data/t_junction_world.yaml", [](LoadedWorld& w) {
-    w.description.origin.alt_m = 123.25;  // heights are WGS-84: the origin's altitude plus the local z
-    w.description.roads[1].design_speed = 50;
-  });
+  Written t =
+      write_world_map(std::string(LIDARLOOP_DATA_DIR) + "/tests/data/t_junction_world.yaml", [](LoadedWorld& w) {
+        w.description.origin.alt_m = 123.25;  // heights are WGS-84: the origin's altitude plus the local z
+        w.description.roads[1].design_speed = 50;
+      });
   const Lanelet2Summary& summary = t.summary;
   EXPECT_EQ(summary.junctions, 1u);
   EXPECT_EQ(summary.road_lanelets, 2u * 3 + 2u * 1 + 4u);
@@ -427,8 +428,7 @@ TEST(Lanelet2Map, TJunctionTurnsEveryWay) {
   EXPECT_EQ(across_mouth, 1u);
   for (const Lanelet2Lanelet& l : t.map.lanelets) {
     if (l.subtype != "road" || l.tags.count("turn_direction")) continue;
-    const bool side = l.left_points.front().x() > 45 && l.left_points.front().x() < 55 &&
-                      l.left_points.front().y() > 5;
+    const bool side = l.left_points.front().x() > 45 && l.left_points.front().x() < 55 && l.left_points.front().y() > 5;
     ASSERT_TRUE(l.speed_limit_mps);
     EXPECT_NEAR(*l.speed_limit_mps * 3.6, side ? 50 : 30, 1e-9) << "lanelet " << l.id;
   }
@@ -497,7 +497,8 @@ TEST(Lanelet2Map, RoutingCheckOfAFile) {
     return ids.size();
   };
   size_t worst = lanelets;
-  for (LaneGraphNodeId n = 0; n < LaneGraphNodeId(graph.nodes.size()); ++n) worst = std::min(worst, reached_lanelets(n));
+  for (LaneGraphNodeId n = 0; n < LaneGraphNodeId(graph.nodes.size()); ++n)
+    worst = std::min(worst, reached_lanelets(n));
   std::cout << "[ figures  ] " << path << ": " << lanelets << " drivable lanelets; "
             << describe_components(lane_graph_components(graph)) << "; from lanelet " << graph.nodes.front().lanelet
             << " " << reached_lanelets(0) << " of " << lanelets << " reachable; the fewest from any: " << worst << "\n";
