@@ -350,13 +350,21 @@ double mouth_distance(const RoadSpec& road, const region::Paths& carriageway, do
 
 // One arm of a junction: a road leaving it, up to its mouth.
 struct Arm {
-  size_t junction, road;
-  int dir;  // +1: the arm runs towards higher arc length
+  size_t junction = 0, road = 0;
+  int dir = 1;  // +1: the arm runs towards higher arc length
   // At the mouth, filled when the road's lanes are written: the points of the lines between lanes,
   // k = 0 (right curb) .. lanes (left curb), exactly the lane bounds' ends; the centreline's direction.
   std::vector<Eigen::Vector2d> points;
   Eigen::Vector2d tangent{1, 0};
 };
+
+Arm arm(size_t junction, size_t road, int dir) {
+  Arm a;
+  a.junction = junction;
+  a.road = road;
+  a.dir = dir;
+  return a;
+}
 
 // A junction's stretch of one road, in the road's arc length (lo may be below 0 or hi beyond the
 // length on a closed road).
@@ -516,12 +524,12 @@ class MapBuilder {
         if (road.closed || jr.s > kArmEnd) {
           span.lo = jr.s - mouth_distance(road, carriageway_, jr.s, -1);
           span.back_arm = arms_.size();
-          arms_.push_back({j, jr.road, -1, {}, {}});
+          arms_.push_back(arm(j, jr.road, -1));
         }
         if (road.closed || jr.s < length - kArmEnd) {
           span.hi = jr.s + mouth_distance(road, carriageway_, jr.s, 1);
           span.forward_arm = arms_.size();
-          arms_.push_back({j, jr.road, 1, {}, {}});
+          arms_.push_back(arm(j, jr.road, 1));
         }
         spans_[jr.road].push_back(span);
       }
