@@ -6,11 +6,11 @@
 
 #include "common/input_error.hpp"
 #include "common/little_endian.hpp"
+#include "common/output_dir.hpp"
 #include "localizer/intensity_map.hpp"
 #include "localizer/map_files.hpp"
 #include "localizer/point_map.hpp"
 #include "logs/pcd_file.hpp"
-#include "common/output_dir.hpp"
 #include "mapping/survey_map.hpp"
 
 namespace lidarloop {
@@ -19,7 +19,9 @@ namespace {
 
 // The point layer re-voxelized, every point with the intensity layer's mean under it where it is
 // ground (at most max_ground_height above the pavement: what that layer accumulates) and 0 elsewhere
-// (the point layer keeps no intensity). Points in tile order, then voxel order: the same bytes every time.
+// (the point layer keeps no intensity). z is the WGS-84 ellipsoidal height, the origin's altitude plus the
+// local z, as the Lanelet2 map's ele (map_projector_info.yaml declares vertical_datum WGS84). Points in tile
+// order, then voxel order: the same bytes every time.
 size_t write_point_cloud(const std::string& path, const std::string& map_dir, const World& world,
                          const MappingOptions& options, double voxel_m) {
   const PointMapHeader layer = read_point_map_header(map_dir);
@@ -46,7 +48,8 @@ size_t write_point_cloud(const std::string& path, const std::string& map_dir, co
       float value = 0;
       if (p.z() - pavement(xy) <= options.max_ground_height)
         if (const auto cell = intensity.cell(xy)) value = cell->mean;
-      for (const float v : {p.x(), p.y(), p.z(), value}) append_le(body, std::bit_cast<uint32_t>(v), 4);
+      const float z = float(double(p.z()) + world.origin.alt_m);
+      for (const float v : {p.x(), p.y(), z, value}) append_le(body, std::bit_cast<uint32_t>(v), 4);
       ++count;
     }
   const std::string head = binary_pcd_header({{"x"}, {"y"}, {"z"}, {"intensity"}}, count,
@@ -60,11 +63,16 @@ size_t write_point_cloud(const std::string& path, const std::string& map_dir, co
 // which is Autoware's TransverseMercator projector (autoware_lanelet2_extension
 // transverse_mercator_projector.cpp: central meridian = map_origin.longitude, y less the origin's
 // northing) given scale_factor 1.0; its default 0.9996 (autoware_map_msgs MapProjectorInfo) would
-// shrink every distance by 0.04 %. Heights: ele and the point cloud's z are metres above the origin,
-// whose altitude is written for people (Autoware overwrites map_origin.altitude with 0).
+// shrink every distance by 0.04 %. Heights: vertical_datum WGS84 says the map frame's z is the WGS-84
+// ellipsoidal height, which Autoware's projector passes through from the GNSS fix's altitude
+// (autoware_geography_utils project_forward: z = altitude); so ele and the point cloud's z are the
+// origin's altitude (taken as ellipsoidal, as the world file gives it) plus the local height.
 void write_projector_info(const std::string& path, const Geodetic& origin) {
   std::ostringstream y;
   y << "# How Autoware's map_projection_loader turns latitude and longitude into this map's frame.\n"
+    << "# x, y: metres east and north of map_origin on its transverse Mercator (scale 1). z (the point\n"
+    << "# cloud's z, the Lanelet2 map's ele): WGS-84 ellipsoidal height, map_origin.altitude plus the\n"
+    << "# height above it.\n"
     << "projector_type: TransverseMercator\n"
     << "vertical_datum: WGS84\n"
     << "scale_factor: 1.0\n"
@@ -91,8 +99,10 @@ AutowareExportSummary export_autoware_map(const std::string& world, const Mappin
     const CurbMap one{w.world.origin, w.world.name, {line}, {}};
     return survey_curb_map(densify_curb_map(one, options.survey_error.sample_spacing_m), survey).curbs.front();
   };
+  // The map's version is the world's hash the map was built from: a changed world is a new map version.
   summary.lanelet2 = write_lanelet2_map(out_dir + "/" + kAutowareLanelet2File, w.description, w.world,
-                                        read_curb_map(map_dir + "/curbs.geojson"), surveyed);
+                                        read_curb_map(map_dir + "/curbs.geojson"), surveyed,
+                                        read_point_map_header(map_dir).world_hash);
   write_projector_info(out_dir + "/" + kAutowareProjectorFile, w.world.origin);
   return summary;
 }

@@ -15,9 +15,9 @@
 #include "common/units.hpp"
 #include "common/yaml_reader.hpp"
 #include "localizer/hd_map.hpp"
+#include "loop/run_outputs.hpp"
 #include "mapping/autoware_export.hpp"
 #include "mapping/map_cache.hpp"
-#include "loop/run_outputs.hpp"
 #include "sim/path.hpp"
 #include "sim/world_assets.hpp"
 #include "tools/commands.hpp"
@@ -92,9 +92,13 @@ void print_export(const AutowareExportSummary& e) {
   std::cout << "autoware     " << e.dir << "/{" << kAutowarePointCloudFile << ", " << kAutowareLanelet2File << ", "
             << kAutowareProjectorFile << "}\n"
             << "  points     " << e.points << "\n"
-            << "  lanelet2   road lanelets " << l.road_lanelets << " (" << l.intersection_lanelets
-            << " in junctions), curbstones " << l.curbstones << ", crosswalks " << l.crosswalks << ", stop lines "
-            << l.stop_lines << " + " << l.derived_stop_lines << " derived before crosswalks, nodes " << l.nodes << "\n";
+            << "  lanelet2   road lanelets " << l.road_lanelets << " (" << l.intersection_lanelets << " in "
+            << l.junctions << " junctions, " << l.turn_lanelets << " joining roads), curbstones " << l.curbstones
+            << ", crosswalks " << l.crosswalks << ", stop lines " << l.stop_lines << " + " << l.derived_stop_lines
+            << " derived before crosswalks, nodes " << l.nodes << "\n";
+  if (l.short_lanelets)
+    std::cout << "  warning    " << l.short_lanelets
+              << " lanelets shorter than 3 m between junctions too close together\n";
 }
 
 int run_map(const Args& args) {

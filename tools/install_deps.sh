@@ -11,7 +11,6 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libpolyclipping-dev nlohmann-json3-dev libzstd-dev
   libopen3d-dev
-  libosmium2-dev
   libpugixml-dev
 )
 
