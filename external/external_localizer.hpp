@@ -18,9 +18,9 @@
 
 #include <Eigen/Geometry>
 
+#include "external/child_process.hpp"
 #include "localizer/localizer.hpp"
 #include "logs/mcap_recorder.hpp"
-#include "external/child_process.hpp"
 
 namespace lidarloop {
 

@@ -4,8 +4,8 @@
 #include <memory>
 #include <string>
 
-#include "localizer/localizer.hpp"
 #include "external/external_localizer.hpp"
+#include "localizer/localizer.hpp"
 #include "loop/kidnap_schedule.hpp"
 
 namespace lidarloop {

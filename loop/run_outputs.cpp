@@ -1,6 +1,5 @@
 #include "loop/run_outputs.hpp"
 
-
 #include <filesystem>
 #include <sstream>
 
@@ -8,9 +7,9 @@
 #include "common/output_dir.hpp"
 #include "localizer/driving_corridor.hpp"
 #include "logs/ros2_messages.hpp"
+#include "loop/fault_events.hpp"
 #include "scoring/birdseye.hpp"
 #include "scoring/error_plots.hpp"
-#include "loop/fault_events.hpp"
 #include "scoring/result_files.hpp"
 #include "sim/sensor_calibration.hpp"
 

@@ -14,8 +14,8 @@
 #include "common/yaml_path.hpp"
 #include "common/yaml_reader.hpp"
 #include "localizer/localizer_params.hpp"
-#include "sweep/sweep_expression.hpp"
 #include "sim/scenario.hpp"
+#include "sweep/sweep_expression.hpp"
 
 namespace lidarloop {
 namespace {

@@ -10,8 +10,8 @@
 #include <iostream>
 #include <optional>
 
-#include "common/output_dir.hpp"
 #include "common/input_error.hpp"
+#include "common/output_dir.hpp"
 #include "logs/localizer_status.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
@@ -19,11 +19,11 @@
 #include "logs/tum_file.hpp"
 #include "loop/localizer_backend.hpp"
 #include "loop/localizer_setup.hpp"
-#include "mapping/map_cache.hpp"
 #include "loop/recorded_log.hpp"
-#include "scoring/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "loop/run_recording.hpp"
+#include "mapping/map_cache.hpp"
+#include "scoring/result_files.hpp"
 #include "tools/commands.hpp"
 
 namespace lidarloop {

@@ -9,17 +9,17 @@
 #include <memory>
 #include <sstream>
 
-#include "common/output_dir.hpp"
 #include "common/input_error.hpp"
+#include "common/output_dir.hpp"
 #include "common/units.hpp"
 #include "loop/localizer_loop.hpp"
 #include "loop/localizer_setup.hpp"
-#include "scoring/paper_tables.hpp"
-#include "scoring/result_files.hpp"
 #include "loop/run_outputs.hpp"
 #include "loop/run_recording.hpp"
-#include "sweep/sweep_plan.hpp"
+#include "scoring/paper_tables.hpp"
+#include "scoring/result_files.hpp"
 #include "sim/sensor_calibration.hpp"
+#include "sweep/sweep_plan.hpp"
 #include "tools/commands.hpp"
 #include "tools/scene_setup.hpp"
 

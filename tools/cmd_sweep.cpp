@@ -14,12 +14,12 @@
 #include "loop/localizer_setup.hpp"
 #include "mapping/map_cache.hpp"
 #include "scoring/result_files.hpp"
+#include "sim/world_assets.hpp"
+#include "sweep/process_pool.hpp"
 #include "sweep/sweep_plan.hpp"
 #include "sweep/sweep_report.hpp"
-#include "sim/world_assets.hpp"
 #include "tools/cluster_render.hpp"
 #include "tools/commands.hpp"
-#include "sweep/process_pool.hpp"
 
 namespace lidarloop {
 namespace {

@@ -14,9 +14,9 @@
 #include "logs/ros2_messages.hpp"
 #include "logs/ros2_schemas.hpp"
 #include "logs/tum_file.hpp"
-#include "scoring/estimate_file.hpp"
 #include "loop/recorded_log.hpp"
 #include "loop/run_recording.hpp"
+#include "scoring/estimate_file.hpp"
 #include "scoring/scorer.hpp"
 
 namespace lidarloop {

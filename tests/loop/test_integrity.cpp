@@ -17,8 +17,8 @@
 
 #include "common/input_error.hpp"
 #include "common/units.hpp"
-#include "scoring/error_plots.hpp"
 #include "loop/fault_events.hpp"
+#include "scoring/error_plots.hpp"
 #include "scoring/result_files.hpp"
 #include "scoring/scorer.hpp"
 
