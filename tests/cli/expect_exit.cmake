@@ -1,6 +1,10 @@
-# Runs COMMAND and checks its exit code and that its output contains EXPECT_OUTPUT.
+# Runs COMMAND and checks its exit code and that its output contains EXPECT_OUTPUT, within TIMEOUT seconds
+# (120 unless given).
+if(NOT DEFINED TIMEOUT)
+  set(TIMEOUT 120)
+endif()
 execute_process(COMMAND ${COMMAND} WORKING_DIRECTORY ${WORKDIR} RESULT_VARIABLE code OUTPUT_VARIABLE out
-                ERROR_VARIABLE err TIMEOUT 120)
+                ERROR_VARIABLE err TIMEOUT ${TIMEOUT})
 string(FIND "${out}${err}" "${EXPECT_OUTPUT}" found)
 if(NOT code EQUAL EXPECT_EXIT OR found EQUAL -1)
   message(FATAL_ERROR "expected exit ${EXPECT_EXIT} and output containing '${EXPECT_OUTPUT}'\n"
