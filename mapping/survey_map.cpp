@@ -39,7 +39,7 @@ SurveyDrive plan_survey(const WorldDescription& d, const SurveyErrorConfig& conf
     drive.lanes.push_back(std::move(l));
   };
   if (d.lanelet2) {  // a Lanelet2 map: chains of lanelets that together drive every one of them
-    const LaneGraph graph = build_lane_graph(d.lanelet2->map);
+    const LaneGraph& graph = d.lanelet2->graph;
     for (const auto& route : covering_routes(graph)) {
       SurveyLane l{nullptr, false, make_path(route_centreline(graph, route), false), drive.length_m, {}};
       for (const auto& p : l.path.points) l.box.extend(p);

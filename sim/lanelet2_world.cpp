@@ -1106,4 +1106,16 @@ World build_lanelet2_world(const Lanelet2Map& map, const Lanelet2WorldParams& pa
   return std::move(b.world);
 }
 
+std::shared_ptr<const Lanelet2Source> load_lanelet2_source(const std::string& file, const std::string& where,
+                                                           const Lanelet2WorldParams& params,
+                                                           const Lanelet2ReadOptions& read) {
+  auto source = std::make_shared<Lanelet2Source>();
+  source->file = file;
+  source->where = where;
+  source->map = read_lanelet2(file, read);
+  source->graph = build_lane_graph(source->map);
+  source->params = params;
+  return source;
+}
+
 }  // namespace lidarloop

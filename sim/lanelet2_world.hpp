@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/lane_graph.hpp"
 #include "sim/lanelet2_file.hpp"
 #include "sim/materials.hpp"
 #include "sim/world_builder.hpp"
@@ -143,13 +144,20 @@ struct Lanelet2BuildReport {
   std::string summary() const;  // several lines, for the CLI
 };
 
-// A world's road network from a Lanelet2 map: the map as read, and how to build it.
+// A world's road network from a Lanelet2 map: the map as read, its routing graph (every route of the
+// ego, the traffic and the mapping drive is planned on it), and how to build it.
 struct Lanelet2Source {
   std::string file;   // the map, as the world names it (resolved against the world file's folder)
   std::string where;  // the world file's entry, file:line:col, for later errors
   Lanelet2Map map;
+  LaneGraph graph;
   Lanelet2WorldParams params;
 };
+
+// Reads the map at `file` (sim/lanelet2_file.hpp) and builds its routing graph once.
+std::shared_ptr<const Lanelet2Source> load_lanelet2_source(const std::string& file, const std::string& where,
+                                                           const Lanelet2WorldParams& params,
+                                                           const Lanelet2ReadOptions& read = {});
 
 // Builds the world. actors_dir holds the parked vehicles' meshes (assets/actors). Throws InputError
 // (naming the map file) for a map whose carriageway is empty.

@@ -11,6 +11,7 @@
 #include "sim/lane_graph.hpp"
 #include "sim/lanelet2_world.hpp"
 #include "sim/region.hpp"
+#include "sim/world_assets.hpp"
 
 namespace lidarloop {
 namespace {
@@ -334,7 +335,7 @@ Path build_path(const PathSpec& p, const WorldDescription& d) {
       if (!d.lanelet2)
         throw InputError(p.where + ": a route by lanelets needs a world from a Lanelet2 map; world '" + d.name +
                          "' has roads");
-      const LaneGraph graph = build_lane_graph(d.lanelet2->map);
+      const LaneGraph& graph = d.lanelet2->graph;
       try {
         const std::vector<LaneGraphNodeId> route =
             p.route_to ? shortest_route(graph, *p.route_from, *p.route_to) : route_from_lanelets(graph, p.lanelets);
@@ -369,8 +370,7 @@ Scenario load_scenario(const std::string& path, const VehicleParams& vehicle, st
   Scenario s = parse(YamlReader::open(path), vehicle, realism);
   // A world given as a file is found beside the scenario, from whatever folder lidarloop runs in; a
   // world's name (maps/<name>/) stays a name.
-  if (s.world.find('/') != std::string::npos || s.world.ends_with(".yaml") || s.world.ends_with(".osm"))
-    s.world = path_beside(path, s.world);
+  if (names_a_world_file(s.world)) s.world = path_beside(path, s.world);
   return s;
 }
 Scenario parse_scenario(const std::string& yaml_text, const std::string& name, const VehicleParams& vehicle,

@@ -18,10 +18,14 @@ std::string data_dir() {
 
 std::string actors_dir() { return data_dir() + "/assets/actors"; }
 
+bool names_a_world_file(const std::string& name_or_path) {
+  const std::string extension = std::filesystem::path(name_or_path).extension().string();
+  return name_or_path.find('/') != std::string::npos || extension == ".yaml" || extension == ".osm";
+}
+
 std::string world_file(const std::string& name_or_path) {
   namespace fs = std::filesystem;
-  const std::string extension = fs::path(name_or_path).extension().string();
-  if (name_or_path.find('/') != std::string::npos || extension == ".yaml" || extension == ".osm") {
+  if (names_a_world_file(name_or_path)) {
     if (!fs::is_regular_file(name_or_path)) throw InputError(name_or_path + ": no such world file");
     return name_or_path;
   }
@@ -56,7 +60,7 @@ LoadedWorld load_scenario_world(const Scenario& scenario) {
 
 Eigen::Isometry3d default_start_pose(const WorldDescription& description, double s) {
   if (description.lanelet2) {  // the longest of the routes the mapping drive takes
-    const LaneGraph graph = build_lane_graph(description.lanelet2->map);
+    const LaneGraph& graph = description.lanelet2->graph;
     const auto routes = covering_routes(graph);
     if (routes.empty()) throw InputError(description.lanelet2->file + ": the map has no lanelet a car can drive");
     return to_isometry(make_path(route_centreline(graph, routes.front()), false).pose_at(s));

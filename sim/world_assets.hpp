@@ -12,6 +12,9 @@ std::string data_dir();
 std::string actors_dir();
 // A world given by name (maps/<name>/world.yaml) or by a path to its YAML file.
 std::string world_file(const std::string& name_or_path);
+// Whether a scenario's `world` names a file (a path, a world.yaml or a Lanelet2 map) rather than a world
+// under maps/.
+bool names_a_world_file(const std::string& name_or_path);
 
 struct LoadedWorld {
   MaterialTable materials;

@@ -208,11 +208,8 @@ std::shared_ptr<const Lanelet2Source> read_lanelet2_source(const YamlReader& y, 
                                                            const std::optional<Geodetic>& origin,
                                                            const WorldGeometryParams& geometry) {
   YamlMap m(y, n, "lanelet2");
-  auto source = std::make_shared<Lanelet2Source>();
-  source->where = m.where();
   const YAML::Node file = m.required("file");
-  source->file = path_beside(y.file(), y.string(file, "file"));
-  Lanelet2WorldParams& p = source->params;
+  Lanelet2WorldParams p;
   p.geometry = geometry;
   m.string("country", p.country)
       .number("parking_occupancy", p.parking_occupancy, 0.0, 1.0)
@@ -224,11 +221,10 @@ std::shared_ptr<const Lanelet2Source> read_lanelet2_source(const YamlReader& y, 
   Lanelet2ReadOptions read;
   read.origin = origin;
   try {
-    source->map = read_lanelet2(source->file, read);
+    return load_lanelet2_source(path_beside(y.file(), y.string(file, "file")), m.where(), p, read);
   } catch (const InputError& e) {
     y.fail(file, e.what());
   }
-  return source;
 }
 
 WorldDescription parse(const YamlReader& y) {
@@ -471,11 +467,8 @@ WorldDescription lanelet2_world_description(const std::string& osm_path) {
   WorldDescription w;
   w.name = std::filesystem::path(osm_path).stem().string();
   w.file = osm_path;
-  auto source = std::make_shared<Lanelet2Source>();
-  source->file = source->where = osm_path;
-  source->map = read_lanelet2(osm_path);
-  w.origin = source->map.origin;
-  w.lanelet2 = std::move(source);
+  w.lanelet2 = load_lanelet2_source(osm_path, osm_path, {});
+  w.origin = w.lanelet2->map.origin;
   return w;
 }
 
