@@ -36,8 +36,10 @@ constexpr uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3
 // of its cells' m2 by one ulp; campus: none). 5: the point-cloud layer (points.yaml, points/) for the
 // gicp method. 6: the survey's scans are the points a driver decodes from the HDL-32E's packets (block
 // azimuth on the 0.01 deg grid, 2 mm ranges, the calibration's elevations). 7: Embree's kernels fixed
-// to SSE4.2 (sim/ray_scene.cpp), so a map built on one machine is the map built on any other.
-constexpr int kMapFormatVersion = 7;
+// to SSE4.2 (sim/ray_scene.cpp), so a map built on one machine is the map built on any other. 8: a
+// Lanelet2 world's lanes are surveyed along the line a car drives (sim/lane_graph.hpp's
+// route_driven_line), not their kinked centrelines.
+constexpr int kMapFormatVersion = 8;
 
 static void hash_bytes(uint64_t& h, const std::string& bytes) {
   for (unsigned char c : bytes) h = (h ^ c) * kFnvPrime;

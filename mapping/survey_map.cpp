@@ -41,7 +41,7 @@ SurveyDrive plan_survey(const WorldDescription& d, const SurveyErrorConfig& conf
   if (d.lanelet2) {  // a Lanelet2 map: chains of lanelets that together drive every one of them
     const LaneGraph& graph = d.lanelet2->graph;
     for (const auto& route : covering_routes(graph)) {
-      SurveyLane l{nullptr, false, make_path(route_centreline(graph, route), false), drive.length_m, {}};
+      SurveyLane l{nullptr, false, make_path(route_driven_line(graph, route), false), drive.length_m, {}};
       for (const auto& p : l.path.points) l.box.extend(p);
       drive.length_m += l.path.length;
       drive.lanes.push_back(std::move(l));

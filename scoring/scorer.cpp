@@ -278,6 +278,27 @@ double percentile_nearest_rank(std::vector<double> values, double percent) {
   return values[index];
 }
 
+namespace {
+// Where on the route a drive starts: the first stretch (smallest arc length) that passes within half a
+// metre of the nearest one and heads the car's way, its nearest point within kReach. An open route that
+// comes back through its start (laps joined by U-turns at a map's edge) passes there several times; the
+// global nearest may be a later pass.
+double starting_arc(const Path& route, const Pose2d& start) {
+  constexpr double kStep = 0.5, kSlack = 0.5, kReach = 10;  // m
+  const Eigen::Vector2d p(start.x, start.y);
+  if (route.closed) return route.project(p);  // one loop, passed once a lap
+  const auto distance = [&](double s) {
+    const Pose2d on = route.pose_at(s);
+    return std::hypot(on.x - p.x(), on.y - p.y());
+  };
+  const double nearest = distance(route.project(p));
+  for (double s = 0; s <= route.length; s += kStep)
+    if (distance(s) <= nearest + kSlack && std::cos(route.pose_at(s).yaw - start.yaw) > 0)
+      return route.project(p, std::max(0.0, s - kStep), std::min(route.length, s + kReach));
+  return route.project(p);
+}
+}  // namespace
+
 std::vector<double> lane_offsets(const std::vector<TruthPose>& truth, const Path& route) {
   if (route.points.size() < 2) throw std::invalid_argument("lane_offsets: the route has fewer than two points");
   std::vector<double> offsets;
@@ -287,7 +308,7 @@ std::vector<double> lane_offsets(const std::vector<TruthPose>& truth, const Path
     const Eigen::Vector2d p(truth[i].pose.x, truth[i].pose.y);
     // The window is not clamped to [0, length]: on a closed route Path::project takes an unwrapped
     // window across the seam and answers unwrapped, so s keeps counting laps; an open route clamps it.
-    s = i == 0 ? route.project(p) : route.project(p, s - kLaneSearch, s + kLaneSearch);
+    s = i == 0 ? starting_arc(route, truth[i].pose) : route.project(p, s - kLaneSearch, s + kLaneSearch);
     const Pose2d on = route.pose_at(s);
     offsets.push_back(-std::sin(on.yaw) * (p.x() - on.x) + std::cos(on.yaw) * (p.y() - on.y));
   }

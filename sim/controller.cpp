@@ -65,8 +65,9 @@ ControllerCommand PathController::update(int64_t t_ns, const Pose2d& rear, doubl
   const double rear_slip = vehicle_.mass * vehicle_.lf * a_lat / (2 * vehicle_.cornering_stiffness_rear * wheelbase);
   const double feed_forward = std::atan(wheelbase * kappa) + K * a_lat;
   const double heading_error = wrap_angle(on_path.yaw + rear_slip - rear.yaw);
-  const double steer = feed_forward + p_.heading_gain * heading_error -
-                       std::atan2(p_.stanley_gain * cross_track, speed + p_.stanley_softening);
+  const double cross_track_steer = std::clamp(std::atan2(p_.stanley_gain * cross_track, speed + p_.stanley_softening),
+                                              -p_.max_cross_track_steer, p_.max_cross_track_steer);
+  const double steer = feed_forward + p_.heading_gain * heading_error - cross_track_steer;
 
   // Speed.
   ControllerCommand out;

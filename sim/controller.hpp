@@ -22,6 +22,11 @@ struct ControllerParams {
   double stanley_gain = 1.5;       // 1/s: cross-track error to steering
   double stanley_softening = 1.0;  // m/s: keeps the gain finite at low speed
   double heading_gain = 1.0;
+  // rad: the most the cross-track feedback may turn the wheels. Stanley's term alone would steer up to
+  // 90 deg towards the path; far off it (a kink, a U-turn) the wheels must then swing faster than the
+  // actuator's max_steer_rate, the loop lags and oscillates in growing swings. Capped, a car far off
+  // the path comes back along a straight approach; within about a metre of it the cap never binds.
+  double max_cross_track_steer = 0.2;
   double preview_s = 0.15;         // look ahead to make up for the steering actuator's lag
   double speed_kp = 0.8;           // (m/s^2) per (m/s)
   double speed_ki = 0.1;           // (m/s^2) per m

@@ -5,13 +5,16 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <numeric>
+#include <optional>
 #include <queue>
 #include <set>
 #include <sstream>
 #include <unordered_map>
 
 #include "common/input_error.hpp"
+#include "common/pose2d.hpp"
 #include "sim/polyline.hpp"
 
 namespace lidarloop {
@@ -229,9 +232,15 @@ std::vector<std::vector<LaneGraphNodeId>> split_runs(const LaneGraph& graph,
                                                      const std::vector<LaneGraphNodeId>& route) {
   std::vector<std::vector<LaneGraphNodeId>> runs;
   for (size_t i = 0; i < route.size(); ++i) {
+    if (route[i] == kUTurn) {
+      if (i == 0 || i + 1 == route.size() || route[i - 1] == kUTurn)
+        throw InputError("route: a U-turn must come between two lanelets");
+      runs.push_back({kUTurn});
+      continue;
+    }
     if (route[i] < 0 || static_cast<size_t>(route[i]) >= graph.nodes.size())
       throw InputError("route: node " + std::to_string(route[i]) + " is not in the lane graph");
-    if (i == 0) {
+    if (i == 0 || route[i - 1] == kUTurn) {
       runs.push_back({route[i]});
       continue;
     }
@@ -284,6 +293,66 @@ Polyline2d run_centreline(const LaneGraph& graph, const std::vector<LaneGraphNod
                   w * sample_polyline(nb.centreline, t * nb.length).point);
   }
   return out;
+}
+
+// Where a node ends and the next starts: position and heading of its centreline's first / last segment.
+Pose2d centreline_end(const LaneGraphNode& n, bool last) {
+  const Polyline2d& c = n.centreline;
+  const Eigen::Vector2d a = last ? c[c.size() - 2] : c[0], b = last ? c.back() : c[1];
+  const Eigen::Vector2d at = last ? b : a;
+  return {at.x(), at.y(), std::atan2(b.y() - a.y(), b.x() - a.x())};
+}
+
+// The loop of a U-turn from the end of `out` to the start of `back`, without its two ends; nullopt when
+// `back` does not start where such a loop reaches (RouteLineOptions). In the frame of out's end (x
+// ahead, y left), back starts at (qx, qy) heading about -x. Three arcs of radius R: right around C1 =
+// (x0, -R), left around C2, right around C3 = (x0, qy + R), with C2 ahead where the circles about C1 and
+// C3 of radius 2 R cross (the arcs are tangent there); x0 = max(qx, 0), a straight before or after.
+std::optional<Polyline2d> u_turn_loop(const LaneGraphNode& out, const LaneGraphNode& back, const RouteLineOptions& o) {
+  const Pose2d p = centreline_end(out, true), q = centreline_end(back, false);
+  const Eigen::Rotation2Dd to_world(p.yaw);
+  const Eigen::Vector2d origin(p.x, p.y);
+  const Eigen::Vector2d local = to_world.inverse() * (Eigen::Vector2d(q.x, q.y) - origin);
+  const double R = o.u_turn_radius, qx = local.x(), qy = local.y();
+  constexpr double kSideSlack = 0.5;  // m: a way back drawn a little to the right of the way out still turns
+  if (std::abs(qx) > o.max_u_turn_shift || qy < -kSideSlack || qy > 2 * R ||
+      std::abs(wrap_angle(q.yaw - p.yaw - std::numbers::pi)) > o.max_u_turn_angle)
+    return std::nullopt;
+  const double x0 = std::max(qx, 0.0), y1 = std::max(qy, 0.0);
+  const Eigen::Vector2d c1(x0, -R), c3(x0, y1 + R);
+  const double half = (y1 + 2 * R) / 2;
+  const Eigen::Vector2d c2(x0 + std::sqrt(4 * R * R - half * half), y1 / 2);
+  const auto angle = [](const Eigen::Vector2d& v) { return std::atan2(v.y(), v.x()); };
+  constexpr double kTwoPi = 2 * std::numbers::pi;
+  const auto positive = [&](double a) { return a - kTwoPi * std::floor(a / kTwoPi); };
+  Polyline2d local_line;
+  const auto arc = [&](const Eigen::Vector2d& centre, double from, double sweep) {  // sweep > 0: left
+    const int n = std::max(2, static_cast<int>(std::ceil(std::abs(sweep) * R / o.step)));
+    for (int i = 0; i <= n; ++i) {
+      const double a = from + sweep * i / n;
+      local_line.push_back(centre + R * Eigen::Vector2d(std::cos(a), std::sin(a)));
+    }
+  };
+  if (qx > 0) local_line.push_back({0, 0});
+  const double a1 = angle(c2 - c1), a2_from = angle(c1 - c2), a2_to = angle(c3 - c2), a3 = angle(c2 - c3);
+  arc(c1, std::numbers::pi / 2, -positive(std::numbers::pi / 2 - a1));
+  arc(c2, a2_from, positive(a2_to - a2_from));
+  arc(c3, a3, -positive(a3 + std::numbers::pi / 2));
+  Polyline2d world;
+  for (const Eigen::Vector2d& v : local_line) world.push_back(origin + to_world * v);
+  if (qx < 0) world.push_back(origin + to_world * Eigen::Vector2d(qx, y1));
+  return world;
+}
+
+Polyline2d u_turn_or_throw(const LaneGraph& graph, LaneGraphNodeId out, LaneGraphNodeId back,
+                           const RouteLineOptions& o) {
+  std::optional<Polyline2d> loop = u_turn_loop(graph.nodes[out], graph.nodes[back], o);
+  if (!loop)
+    throw InputError("route: a U-turn cannot take " + describe_node(graph, out) + " back into " +
+                     describe_node(graph, back) + ": the way back must start within " +
+                     std::to_string(int(o.max_u_turn_shift)) + " m of where the way out ends, on its left, " +
+                     "heading back");
+  return *loop;
 }
 
 }  // namespace
@@ -473,7 +542,11 @@ std::vector<LaneGraphNodeId> shortest_route(const LaneGraph& graph, const Eigen:
   return route;
 }
 
-std::vector<LaneGraphNodeId> route_from_lanelets(const LaneGraph& graph, const std::vector<Lanelet2Id>& lanelets) {
+std::vector<LaneGraphNodeId> route_from_lanelets(const LaneGraph& graph, const std::vector<Lanelet2Id>& lanelets,
+                                                 const std::vector<size_t>& u_turns) {
+  const std::set<size_t> turn_before(u_turns.begin(), u_turns.end());
+  if (!turn_before.empty() && (*turn_before.begin() == 0 || *turn_before.rbegin() >= lanelets.size()))
+    throw InputError("route: a U-turn must come between two lanelets");
   if (lanelets.empty()) throw InputError("route: the list of lanelets is empty");
   // Each lanelet may have two nodes (a bidirectional one): keep, for each candidate, the one before it
   // that connects (a tiny Viterbi), so the direction is chosen by what comes before and after.
@@ -491,11 +564,17 @@ std::vector<LaneGraphNodeId> route_from_lanelets(const LaneGraph& graph, const s
     for (const auto& entry : back[i - 1])
       for (LaneGraphNodeId c : candidates[i]) {
         const LaneGraphNodeId p = entry.first;
-        if (is_successor(graph.nodes[p], c) || may_change_into(graph.nodes[p], c)) back[i].emplace(c, p);
+        const bool connects = turn_before.count(i)
+                                  ? u_turn_loop(graph.nodes[p], graph.nodes[c], {}).has_value()
+                                  : is_successor(graph.nodes[p], c) || may_change_into(graph.nodes[p], c);
+        if (connects) back[i].emplace(c, p);
         beside = beside || is_neighbour(graph.nodes[p], c);
       }
     if (back[i].empty()) {
       const std::string a = std::to_string(lanelets[i - 1]), b = std::to_string(lanelets[i]);
+      if (turn_before.count(i))
+        throw InputError("route: no U-turn takes lanelet " + a + " back into lanelet " + b +
+                         ": the way back must start near where the way out ends, heading back");
       throw InputError("route: lanelet " + b +
                        (beside ? " is beside lanelet " + a +
                                      " but their shared bound forbids "
@@ -503,26 +582,44 @@ std::vector<LaneGraphNodeId> route_from_lanelets(const LaneGraph& graph, const s
                                : " neither follows lanelet " + a + " nor is beside it"));
     }
   }
-  std::vector<LaneGraphNodeId> route(lanelets.size());
-  route.back() = back.back().begin()->first;
-  for (size_t i = lanelets.size() - 1; i > 0; --i) route[i - 1] = back[i].at(route[i]);
+  std::vector<LaneGraphNodeId> nodes(lanelets.size());
+  nodes.back() = back.back().begin()->first;
+  for (size_t i = lanelets.size() - 1; i > 0; --i) nodes[i - 1] = back[i].at(nodes[i]);
+  std::vector<LaneGraphNodeId> route;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    if (turn_before.count(i)) route.push_back(kUTurn);
+    route.push_back(nodes[i]);
+  }
   return route;
 }
 
 Polyline2d route_centreline(const LaneGraph& graph, const std::vector<LaneGraphNodeId>& route,
-                            double lane_change_length) {
+                            const RouteLineOptions& options) {
+  const std::vector<std::vector<LaneGraphNodeId>> runs = split_runs(graph, route);
   Polyline2d out;
-  for (const auto& run : split_runs(graph, route)) {
-    const Polyline2d piece = run_centreline(graph, run, lane_change_length);
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const Polyline2d piece = runs[r].front() == kUTurn
+                                 ? u_turn_or_throw(graph, runs[r - 1].back(), runs[r + 1].front(), options)
+                                 : run_centreline(graph, runs[r], options.lane_change_length);
     for (const Eigen::Vector2d& p : piece)
       if (out.empty() || (p - out.back()).norm() > 1e-3) out.push_back(p);
   }
   return out;
 }
 
-double route_length(const LaneGraph& graph, const std::vector<LaneGraphNodeId>& route) {
+Polyline2d route_driven_line(const LaneGraph& graph, const std::vector<LaneGraphNodeId>& route,
+                             const RouteLineOptions& options) {
+  return smooth_polyline(route_centreline(graph, route, options), options.smoothing_sigma, options.step);
+}
+
+double route_length(const LaneGraph& graph, const std::vector<LaneGraphNodeId>& route,
+                    const RouteLineOptions& options) {
+  const std::vector<std::vector<LaneGraphNodeId>> runs = split_runs(graph, route);
   double length = 0;
-  for (const auto& run : split_runs(graph, route)) length += mean_length(graph, run);
+  for (size_t r = 0; r < runs.size(); ++r)
+    length += runs[r].front() == kUTurn
+                  ? polyline_length(u_turn_or_throw(graph, runs[r - 1].back(), runs[r + 1].front(), options))
+                  : mean_length(graph, runs[r]);
   return length;
 }
 

@@ -97,20 +97,54 @@ struct RouteOptions {
 std::vector<LaneGraphNodeId> shortest_route(const LaneGraph& graph, const Eigen::Vector2d& from,
                                             const Eigen::Vector2d& to, const RouteOptions& options = {});
 
+// A U-turn in a route: the car turns back from the end of the node before into the node after, whose
+// start is where the one before ends (the same road driven the other way: a bidirectional lanelet's
+// other node, or the opposite lane), on a loop beyond the lanelets' end. Maps end at their edges, and a
+// test drive that is to be longer than the mapped streets turns there, as a mapping car does.
+constexpr LaneGraphNodeId kUTurn = -1;
+
 // A scenario's `route: {lanelets: [id, ...]}`: the nodes in order, each the next one's predecessor or
-// a neighbour it may change into (a bidirectional lanelet's direction is the one that connects).
-// InputError naming the lanelet not in the graph, or the two lanelets that do not connect.
-std::vector<LaneGraphNodeId> route_from_lanelets(const LaneGraph& graph, const std::vector<Lanelet2Id>& lanelets);
+// a neighbour it may change into (a bidirectional lanelet's direction is the one that connects), or,
+// at the indices in u_turns (a U-turn before lanelets[i]), the start of the way back: kUTurn is put
+// between them. InputError naming the lanelet not in the graph, or the two lanelets that do not connect.
+std::vector<LaneGraphNodeId> route_from_lanelets(const LaneGraph& graph, const std::vector<Lanelet2Id>& lanelets,
+                                                 const std::vector<size_t>& u_turns = {});
+
+struct RouteLineOptions {
+  double lane_change_length = 30;  // m over which a lane change blends one lane's centre into the next
+  // m: a U-turn's loop is arcs of this radius (right 60 deg, left 300 deg, right 60 deg when it comes
+  // back to where it began: the "light bulb" turn), about a passenger car's smallest turning radius
+  // (kerb-to-kerb turning circles of 10.5-11.5 m, e.g. VW Golf VIII 10.9 m) with room to spare.
+  double u_turn_radius = 6.0;
+  // Where the way back may start, seen from the end of the way out: at most max_u_turn_shift ahead or
+  // behind, 0 to 2 u_turn_radius to the left, heading back within max_u_turn_angle.
+  double max_u_turn_shift = 10.0;  // m
+  double max_u_turn_angle = 0.5;   // rad
+  // For route_driven_line: the centreline smoothed over this much arc length (m, the Gaussian's
+  // standard deviation). A kink of a rad becomes a bend of curvature a / (2.5 sigma) (0.5 rad: radius
+  // 7.5 m, above a car's smallest turning radius), and a bend of radius 15 m moves in by 7 cm.
+  double smoothing_sigma = 1.5;
+  double step = 0.5;  // m between the driven line's points
+};
 
 // The route's centrelines joined into one line. A run of lane changes (consecutive neighbours) is
 // driven along the run's lanelets, each for an equal share of their length, changing lane by a smooth
-// (smoothstep) transition over lane_change_length metres. InputError naming both lanelet ids when
-// consecutive nodes are neither successors nor neighbours.
+// (smoothstep) transition over lane_change_length metres; a kUTurn is a loop from the end of the node
+// before it to the start of the node after. InputError naming both lanelet ids when consecutive nodes
+// are neither successors nor neighbours, or when the way back does not start where a U-turn can reach.
 Polyline2d route_centreline(const LaneGraph& graph, const std::vector<LaneGraphNodeId>& route,
-                            double lane_change_length = 30);
+                            const RouteLineOptions& options = {});
+// The line a car drives along a route: route_centreline smoothed (sim/polyline.hpp's smooth_polyline).
+// Centrelines made from a map's bounds kink where lanelets meet (lanes of different widths, a lane
+// change run joining its successor: 0.6 rad within a metre on Karlsruhe's roundabout), and a path
+// controller's curvature feed-forward turns each kink into a steering spike that a car at speed
+// cannot follow. A driver steers through such a kink over about a car length.
+Polyline2d route_driven_line(const LaneGraph& graph, const std::vector<LaneGraphNodeId>& route,
+                             const RouteLineOptions& options = {});
 // Its length without building it: successors add their lengths; a run of neighbours counts once, at
-// its lanelets' mean length.
-double route_length(const LaneGraph& graph, const std::vector<LaneGraphNodeId>& route);
+// its lanelets' mean length; a U-turn adds its loop's length.
+double route_length(const LaneGraph& graph, const std::vector<LaneGraphNodeId>& route,
+                    const RouteLineOptions& options = {});
 
 // A few chains of successors that together drive every drivable lanelet at least once (one direction
 // of a bidirectional one is enough), longest first: the mapping drive follows them. Greedy: a chain

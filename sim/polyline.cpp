@@ -27,6 +27,32 @@ PolylineSample sample_polyline(const Polyline2d& line, double s) {
   return {line.back(), {1, 0}};
 }
 
+Polyline2d smooth_polyline(const Polyline2d& line, double sigma, double step) {
+  const double length = polyline_length(line);
+  if (line.size() < 2 || sigma <= 0 || step <= 0 || length <= 0) return line;
+  const size_t n = static_cast<size_t>(std::ceil(length / step)) + 1;
+  std::vector<Eigen::Vector2d> samples(n);
+  for (size_t i = 0; i < n; ++i)
+    samples[i] = sample_polyline(line, length * static_cast<double>(i) / static_cast<double>(n - 1)).point;
+  const double spacing = length / static_cast<double>(n - 1);
+  const long reach = static_cast<long>(std::ceil(3 * sigma / spacing));
+  Polyline2d out(n);
+  for (size_t i = 0; i < n; ++i) {
+    const long here = static_cast<long>(i), last = static_cast<long>(n) - 1;
+    const long half = std::min({reach, here, last - here});  // symmetric: no pull towards the inside at the ends
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    double weights = 0;
+    for (long j = -half; j <= half; ++j) {
+      const double u = static_cast<double>(j) * spacing / sigma;
+      const double w = std::exp(-0.5 * u * u);
+      sum += w * samples[static_cast<size_t>(here + j)];
+      weights += w;
+    }
+    out[i] = sum / weights;
+  }
+  return out;
+}
+
 double project_onto_polyline(const Polyline2d& line, const Eigen::Vector2d& p) {
   double best = std::numeric_limits<double>::max(), best_s = 0, s = 0;
   for (size_t i = 1; i < line.size(); ++i) {

@@ -25,6 +25,13 @@ double project_onto_polyline(const Polyline2d& line, const Eigen::Vector2d& p);
 // A closed line is given without its repeated first point and returned with it.
 Polyline2d fillet_polyline(const Polyline2d& line, double radius, bool closed, double max_step_rad);
 
+// The line as a driver steers it: resampled every `step` metres and each sample moved to the Gaussian-
+// weighted mean (standard deviation `sigma` metres of arc length) of the line around it, the window
+// shrunk symmetrically near the ends so that the ends stay put and a straight line stays straight. A
+// kink of angle a becomes a bend of curvature about a / (2.5 sigma); an arc of radius R moves inwards by
+// about sigma^2 / (2 R).
+Polyline2d smooth_polyline(const Polyline2d& line, double sigma, double step);
+
 // The line shifted sideways by `offset` (positive = left of the direction of travel), mitred joins.
 Polyline2d offset_polyline(const Polyline2d& line, double offset, bool closed);
 

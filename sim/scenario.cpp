@@ -106,10 +106,19 @@ PathSpec read_path(const YamlReader& y, const YAML::Node& n, const char* what) {
   if (lanelets) {
     p.kind = PathSpec::Kind::lanelets;
     y.expect_sequence(lanelets, "lanelets");
-    for (const auto& id : lanelets)
-      p.lanelets.push_back(
-          y.integer_in(id, "a lanelet id", std::numeric_limits<long>::min(), std::numeric_limits<long>::max()));
+    for (const auto& id : lanelets) {
+      if (id.IsScalar() && id.Scalar() == "u_turn") {
+        if (p.lanelets.empty() || (!p.u_turns.empty() && p.u_turns.back() == p.lanelets.size()))
+          y.fail(id, "a U-turn must come between two lanelets");
+        p.u_turns.push_back(p.lanelets.size());
+        continue;
+      }
+      p.lanelets.push_back(y.integer_in(id, "a lanelet id (or u_turn)", std::numeric_limits<long>::min(),
+                                        std::numeric_limits<long>::max()));
+    }
     if (p.lanelets.empty()) y.fail(lanelets, "a route needs at least one lanelet");
+    if (!p.u_turns.empty() && p.u_turns.back() == p.lanelets.size())
+      y.fail(lanelets, "a U-turn must come between two lanelets, not at the end");
   }
   if (to) {
     p.kind = PathSpec::Kind::lanelets;
@@ -319,17 +328,23 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   return s;
 }
 
-Path build_path(const PathSpec& p, const WorldDescription& d) {
+// A built path, and where its U-turns leave the lanelets (their loops run beyond the map's lanes).
+struct BuiltPath {
+  Path path;
+  std::vector<Eigen::Vector2d> u_turns;
+};
+
+BuiltPath build_path(const PathSpec& p, const WorldDescription& d) {
   switch (p.kind) {
     case PathSpec::Kind::road: {
       const RoadSpec* road = d.road(p.road);
       if (!road) throw InputError(p.where + ": unknown road '" + p.road + "' in world '" + d.name + "'");
-      return lane_path(*road, p.lane, p.backward, p.offset ? &*p.offset : nullptr);
+      return BuiltPath{lane_path(*road, p.lane, p.backward, p.offset ? &*p.offset : nullptr), {}};
     }
     case PathSpec::Kind::waypoints: {
       Polyline2d corners = p.waypoints;
       if (p.closed && (corners.front() - corners.back()).norm() < 0.01) corners.pop_back();
-      return make_path(fillet_polyline(corners, p.smoothing_radius, p.closed, 3 * kDeg), p.closed);
+      return BuiltPath{make_path(fillet_polyline(corners, p.smoothing_radius, p.closed, 3 * kDeg), p.closed), {}};
     }
     case PathSpec::Kind::lanelets: {
       if (!d.lanelet2)
@@ -337,9 +352,12 @@ Path build_path(const PathSpec& p, const WorldDescription& d) {
                          "' has roads");
       const LaneGraph& graph = d.lanelet2->graph;
       try {
-        const std::vector<LaneGraphNodeId> route =
-            p.route_to ? shortest_route(graph, *p.route_from, *p.route_to) : route_from_lanelets(graph, p.lanelets);
-        return make_path(route_centreline(graph, route), false);
+        const std::vector<LaneGraphNodeId> route = p.route_to ? shortest_route(graph, *p.route_from, *p.route_to)
+                                                              : route_from_lanelets(graph, p.lanelets, p.u_turns);
+        BuiltPath built{make_path(route_driven_line(graph, route), false), {}};
+        for (size_t i = 1; i < route.size(); ++i)
+          if (route[i] == kUTurn) built.u_turns.push_back(graph.nodes[route[i - 1]].centreline.back());
+        return built;
       } catch (const InputError& e) {
         throw InputError(p.where + ": " + e.what());
       }
@@ -349,16 +367,23 @@ Path build_path(const PathSpec& p, const WorldDescription& d) {
         throw InputError(p.where + ": world '" + d.name + "' has " + std::to_string(d.crosswalks.size()) +
                          " crosswalks; there is no crosswalk " + std::to_string(p.crosswalk));
       const CrosswalkSpec& c = d.crosswalks[size_t(p.crosswalk)];
-      return crosswalk_path(*d.road(c.road), c, p.from_left);
+      return BuiltPath{crosswalk_path(*d.road(c.road), c, p.from_left), {}};
     }
   }
   return {};
 }
 
-void check_on_network(const Path& path, const region::Paths& area, const std::string& where, const char* what) {
+void check_on_network(const BuiltPath& built, const region::Paths& area, const std::string& where, const char* what) {
+  const Path& path = built.path;
+  // A U-turn's loop reaches about 2.7 radii ahead of where it leaves the lanelets and 1.5 to each side.
+  const double loop_reach = 3 * RouteLineOptions{}.u_turn_radius;
+  const auto in_a_u_turn = [&](const Eigen::Vector2d& p) {
+    return std::any_of(built.u_turns.begin(), built.u_turns.end(),
+                       [&](const Eigen::Vector2d& u) { return (p - u).norm() < loop_reach; });
+  };
   for (double s = 0; s <= path.length; s += kPathCheckStep) {
     const Pose2d p = path.pose_at(s);
-    if (!region::contains(area, {p.x, p.y}))
+    if (!region::contains(area, {p.x, p.y}) && !in_a_u_turn({p.x, p.y}))
       throw InputError(where + ": " + what + " leaves the road network at (" + std::to_string(int(std::lround(p.x))) +
                        ", " + std::to_string(int(std::lround(p.y))) + "), " + std::to_string(int(s)) + " m along it");
   }
@@ -429,8 +454,9 @@ std::vector<std::string> realism_overrides(const Scenario& scenario) {
 
 ResolvedScenario resolve_scenario(const Scenario& s, const WorldDescription& d, const World& world) {
   ResolvedScenario r;
-  r.ego_route = build_path(s.ego.route, d);
-  check_on_network(r.ego_route, world.carriageway, s.ego.route.where, "the ego's route");
+  const BuiltPath ego = build_path(s.ego.route, d);
+  check_on_network(ego, world.carriageway, s.ego.route.where, "the ego's route");
+  r.ego_route = ego.path;
   if (!r.ego_route.closed && s.ego.start_at >= r.ego_route.length)
     throw InputError(s.ego.where + ": start_at is beyond the end of the route (" +
                      std::to_string(int(r.ego_route.length)) + " m)");
@@ -444,9 +470,10 @@ ResolvedScenario resolve_scenario(const Scenario& s, const WorldDescription& d, 
       if (!world.bounds.contains(a.position)) throw InputError(a.where + ": parked actor is outside the world");
       plan.path = make_path({a.position, a.position + Eigen::Vector2d(std::cos(a.yaw), std::sin(a.yaw)) * 1e-3}, false);
     } else {
-      plan.path = build_path(a.path, d);
+      const BuiltPath built = build_path(a.path, d);
       const bool on_foot = a.type == ActorType::pedestrian || a.type == ActorType::cyclist;
-      check_on_network(plan.path, on_foot ? walkable : world.carriageway, a.path.where, "the actor's path");
+      check_on_network(built, on_foot ? walkable : world.carriageway, a.path.where, "the actor's path");
+      plan.path = built.path;
       plan.start_s = a.start_at;
       plan.speed = a.speed;
       plan.depart_ns = int64_t(a.depart_s * 1e9);

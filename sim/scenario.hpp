@@ -39,8 +39,10 @@ struct PathSpec {
   int crosswalk = -1;
   bool from_left = false;
   // kind == lanelets, on a world from a Lanelet2 map (sim/lane_graph.hpp): the lanelets in driving
-  // order, or the shortest route between two points
+  // order (`u_turn` between two of them: a U-turn at the end of the one before, before lanelets[i] for
+  // each i in u_turns), or the shortest route between two points
   std::vector<int64_t> lanelets;
+  std::vector<size_t> u_turns;
   std::optional<Eigen::Vector2d> route_from, route_to;
 };
 

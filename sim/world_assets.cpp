@@ -63,7 +63,7 @@ Eigen::Isometry3d default_start_pose(const WorldDescription& description, double
     const LaneGraph& graph = description.lanelet2->graph;
     const auto routes = covering_routes(graph);
     if (routes.empty()) throw InputError(description.lanelet2->file + ": the map has no lanelet a car can drive");
-    return to_isometry(make_path(route_centreline(graph, routes.front()), false).pose_at(s));
+    return to_isometry(make_path(route_driven_line(graph, routes.front()), false).pose_at(s));
   }
   return to_isometry(lane_path(description.roads.front(), Lane::right, false).pose_at(s));
 }

@@ -535,6 +535,28 @@ TEST(LaneOffsets, FollowTheCarRoundAClosedRouteLapAfterLap) {
   EXPECT_EQ(m.failures, std::vector<std::string>{"no estimates"});  // and nothing about the lane
 }
 
+// A route that passes its start again later (two laps of a spiral, as a scenario's laps joined by
+// U-turns at a map's edge come back through the start): the car on its first lap, 0.15 m inside it, is
+// nearer to the second lap (0.05 m) at the start. Its offset is to the first lap, all the way round.
+TEST(LaneOffsets, AnOpenRouteThatComesBackThroughItsStartIsFollowedFromItsFirstPass) {
+  constexpr double kInside = 0.15, kInward = 0.2;  // m; kInward: the second lap's radius is this much less
+  Polyline2d spiral;
+  for (double deg = 0; deg <= 720 + 1e-9; deg += kCircleVertexStep) {
+    const double a = deg * kDeg, r = kCircleRadius - kInward * a / (2 * kPi);
+    spiral.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  const Path route = make_path(spiral, false);
+  std::vector<TruthPose> truth;
+  const double lap_s = 2 * kPi * kCircleRadius / kLaneSpeed;
+  for (int64_t t = 0; t < int64_t(0.9 * lap_s * double(kNsPerS)); t += kTruthStep) {
+    const double a = kLaneSpeed * ns_to_s(t) / kCircleRadius;
+    const double r = kCircleRadius - kInward * a / (2 * kPi) - kInside;
+    truth.push_back({t, {r * std::cos(a), r * std::sin(a), wrap_angle(a + kPi / 2)}});
+  }
+  const std::vector<double> offsets = lane_offsets(truth, route);
+  for (size_t i = 0; i < truth.size(); ++i) EXPECT_NEAR(offsets[i], kInside, kLaneTolerance) << "sample " << i;
+}
+
 TEST(LaneOffsets, AnOpenRouteEndsWhereItEnds) {
   // Most of the circle, open: its end is 8.7 m from its start. Driven once to the right of it, then
   // on past the end along its last segment: the projection stays at the end rather than wrapping to

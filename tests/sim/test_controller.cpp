@@ -56,6 +56,28 @@ TEST(Controller, FollowsTheCampusLoopAt10MetresPerSecond) {
   EXPECT_NEAR(d.max_speed, 10.0, 0.3);
 }
 
+// Far off the path (a U-turn's wide exit, a start beside the lane) the cross-track feedback is capped
+// (ControllerParams::max_cross_track_steer): the car comes back along a straight approach instead of
+// swinging across the path in growing arcs while the steering actuator lags at its rate limit.
+TEST(Controller, ComesBackFromThreeMetresOffWithoutSwingingAcross) {
+  const Path path = make_path({{0, 0}, {400, 0}}, false);
+  const VehicleParams vp;
+  VehicleModel car(vp, VehicleModel::state_at(vp, {0, 3.0, 0}, 6.0));
+  PathController controller(path, 6.0, {}, vp);
+  double overshoot = 0, last = 0;
+  ControllerCommand cmd;
+  for (int64_t step = 0; step < 30000; ++step) {  // 30 s of 1 ms steps, the driver at 100 Hz
+    if (step % 10 == 0) {
+      cmd = controller.update(step * vp.step_ns, car.rear_axle_pose(), car.state().vx);
+      overshoot = std::max(overshoot, -cmd.cross_track);  // started on the left: right of the path is overshoot
+      last = cmd.cross_track;
+    }
+    car.step(cmd.command);
+  }
+  EXPECT_LT(overshoot, 0.3);
+  EXPECT_LT(std::abs(last), 0.02);
+}
+
 TEST(Controller, StopsAtTheStopAndWaits) {
   const Drive d = drive(campus_lane(), 70, 8.0, 0.0, 25, {{120, 3.0}});
   const Eigen::Vector2d stop_point(campus_lane().pose_at(120).x, campus_lane().pose_at(120).y);

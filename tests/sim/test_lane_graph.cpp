@@ -16,7 +16,9 @@
 #include "common/input_error.hpp"
 #include "sim/lane_graph.hpp"
 #include "sim/lanelet2_file.hpp"
+#include "sim/path.hpp"
 #include "sim/polyline.hpp"
+#include "sim/scenario.hpp"
 
 namespace lidarloop {
 namespace {
@@ -191,7 +193,7 @@ TEST(LaneGraph, LanesOfOppositeDirectionsSharingABoundAreNoNeighbours) {
 TEST(LaneGraph, LaneChangeCentrelineIsASmoothTransition) {
   const LaneGraph graph = parallel_lanes("line_thin", "dashed", false);
   const auto route = route_from_lanelets(graph, {1, 2});
-  const Polyline2d line = route_centreline(graph, route, 30);
+  const Polyline2d line = route_centreline(graph, route, {.lane_change_length = 30});
   EXPECT_NEAR(line.front().y(), -1.75, 1e-9);
   EXPECT_NEAR(line.back().y(), 1.75, 1e-9);
   EXPECT_NEAR(route_length(graph, route), 100, 1e-9);
@@ -336,6 +338,72 @@ TEST(LaneGraph, BidirectionalLaneletGivesANodePerDirection) {
   EXPECT_EQ(shortest_route(graph, {40, 0}, {10, 0}), std::vector<LaneGraphNodeId>{*backward});
 }
 
+// A U-turn at the end of a two-way street (one bidirectional lanelet, 50 m): the "light bulb" loop of
+// three arcs of radius R (right 60 deg, left 300 deg, right 60 deg) reaches R (1 + sqrt 3) beyond the
+// end and comes back to where it left, heading the other way.
+TEST(LaneGraph, UTurnLoopsBeyondTheEndAndComesBackToTheWayBack) {
+  MapBuilder b;
+  b.lanelet(6, b.line(straight(-10, 3, 0, 3)), b.line(straight(-10, -3, 0, -3)));  // one way in: sets the direction
+  b.lanelet(7, b.line(straight(0, 3, 50, 3)), b.line(straight(0, -3, 50, -3)), false, false, "", false);
+  const LaneGraph graph = build_lane_graph(b.map);
+  auto route = route_from_lanelets(graph, {6, 7, 7}, {2});
+  ASSERT_EQ(route.size(), 4u);
+  EXPECT_EQ(route[1], *lane_graph_node(graph, 7));
+  EXPECT_EQ(route[2], kUTurn);
+  EXPECT_EQ(route[3], *lane_graph_node(graph, 7, true));
+  route.erase(route.begin());
+  const RouteLineOptions o;
+  const double R = o.u_turn_radius;
+  const Polyline2d line = route_centreline(graph, route, o);
+  double reach = 0;
+  for (const auto& p : line) reach = std::max(reach, p.x());
+  EXPECT_NEAR(reach, 50 + R * (1 + std::sqrt(3.0)), 0.05);
+  EXPECT_NEAR(line.back().x(), 0, 1e-9);
+  // The loop: arcs of 60 + 300 + 60 deg at radius R.
+  const double loop = 7 * std::numbers::pi / 3 * R;
+  EXPECT_NEAR(polyline_length(line), 50 + loop + 50, 0.1);
+  EXPECT_NEAR(route_length(graph, route), 50 + loop + 50, 0.1);
+  // Every point of the loop is R from one of the three centres (x ahead, y left of the way out's end).
+  const Eigen::Vector2d c1(50, -R), c2(50 + R * std::sqrt(3.0), 0), c3(50, R);
+  for (const auto& p : line) {
+    if (p.x() <= 50) continue;
+    const double d =
+        std::min({std::abs((p - c1).norm() - R), std::abs((p - c2).norm() - R), std::abs((p - c3).norm() - R)});
+    EXPECT_LT(d, 1e-6) << p.transpose();
+  }
+  // Driven, the line keeps to a car's turning radius: the smoothed loop's tightest bend is no tighter.
+  const Path driven = make_path(route_driven_line(graph, route), false);
+  for (double s = 0; s < driven.length; s += 0.5) EXPECT_LT(std::abs(driven.curvature_at(s)), 1.0 / (R - 0.3));
+}
+
+// A divided road's opposite lane, 3.5 m to the left: the loop comes back into it. A way back that
+// starts 40 m before the turn or heads the same way is no U-turn, and the message says what would be.
+TEST(LaneGraph, UTurnIntoTheOppositeLaneAndErrors) {
+  MapBuilder b;
+  b.lanelet(1, b.line(straight(0, 0, 50, 0)), b.line(straight(0, -3.5, 50, -3.5)));
+  b.lanelet(2, b.line(straight(50, 0, 0, 0)), b.line(straight(50, 3.5, 0, 3.5)));
+  b.lanelet(3, b.line(straight(10, 3.5, 0, 3.5)), b.line(straight(10, 7, 0, 7)));    // starts 40 m back
+  b.lanelet(4, b.line(straight(50, 7, 60, 7)), b.line(straight(50, 3.5, 60, 3.5)));  // heads on
+  const LaneGraph graph = build_lane_graph(b.map);
+  const auto route = route_from_lanelets(graph, {1, 2}, {1});
+  const Polyline2d line = route_centreline(graph, route);
+  EXPECT_NEAR(line.back().x(), 0, 1e-9);
+  EXPECT_NEAR(line.back().y(), 1.75, 1e-9);
+  const auto u_turn_error = [&](Lanelet2Id back) {
+    try {
+      route_from_lanelets(graph, {1, back}, {1});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(u_turn_error(3),
+            "route: no U-turn takes lanelet 1 back into lanelet 3: the way back must start near "
+            "where the way out ends, heading back");
+  EXPECT_NE(u_turn_error(4).find("no U-turn takes lanelet 1 back into lanelet 4"), std::string::npos);
+  EXPECT_THROW(route_from_lanelets(graph, {1, 2}, {0}), InputError);  // nothing to turn from
+}
+
 TEST(LaneGraph, CoveringRoutesCoverEveryLanelet) {
   const LaneGraph graph = build_lane_graph(t_junction().map);
   const auto routes = covering_routes(graph);
@@ -390,69 +458,62 @@ int junctions_on(const LaneGraph& graph, const std::vector<LaneGraphNodeId>& rou
   for (const auto& node : graph.nodes)
     for (LaneGraphNodeId s : node.successors) ++predecessors[s];
   int count = 0;
-  for (size_t i = 1; i < route.size(); ++i)
+  for (size_t i = 1; i < route.size(); ++i) {
+    if (route[i - 1] == kUTurn || route[i] == kUTurn) continue;
     if (graph.nodes[route[i - 1]].successors.size() > 1 || predecessors[route[i]] > 1) ++count;
+  }
   return count;
 }
 
-Eigen::Vector2d middle_of(const LaneGraph& graph, LaneGraphNodeId node) {
-  const LaneGraphNode& n = graph.nodes[node];
-  return sample_polyline(n.centreline, 0.5 * n.length).point;
-}
-
 // The real Karlsruhe map (Lanelet2's mapping example, issue 35) when ../shared/data holds it: its
-// components, and a drive of at least 1.5 km through its junctions. The map is a mapping example, not a
-// closed network: most lanes end at its edge, its longest shortest route is about 560 m, and the
-// largest strongly connected part is a few blocks. So the long drive is laps of the longest round
-// trip in that part (out by one shortest route, back by another), given as lanelet ids as a scenario
-// gives them.
-TEST(LaneGraph, KarlsruheHasADriveOfOneAndAHalfKilometresThroughJunctions) {
-  const std::string path =
-      std::string(LIDARLOOP_DATA_DIR) + "/../shared/data/maps/lanelet2/karlsruhe_mapping_example.osm";
+// components, and the drive scenarios/karlsruhe.yaml gives, lanelet by lanelet. The map is a mapping
+// example, not a closed network: its largest part (a big roundabout) is edged by road borders, with
+// hardly a curbstone; the part drawn with curbs is a tree of two-way streets around a small roundabout
+// whose ends leave the map. So the drive turns back where a street leaves the map: at least 1.5 km,
+// through junctions, most of it with a curbstone within reach of the HDL-32E's curb detection.
+TEST(LaneGraph, KarlsruheScenarioDrivesOneAndAHalfKilometresAlongCurbs) {
+  const std::string data = std::string(LIDARLOOP_DATA_DIR);
+  const std::string path = data + "/../shared/data/maps/lanelet2/karlsruhe_mapping_example.osm";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not there";
-  const LaneGraph graph = build_lane_graph(read_lanelet2(path));
+  const Lanelet2Map map = read_lanelet2(path);
+  const LaneGraph graph = build_lane_graph(map);
   const LaneGraphComponents components = lane_graph_components(graph);
   std::cout << "Karlsruhe: " << graph.nodes_of.size() << " drivable lanelets; " << describe_components(components)
             << "\n";
-  for (const auto& [what, count] : graph.not_drivable) std::cout << "  not drivable " << what << ": " << count << "\n";
   // 337 road + 8 highway lanelets, less the 17 roads tagged for bicycles and pedestrians only.
   EXPECT_EQ(graph.nodes_of.size(), 328u);
 
-  // The longest round trip between two nodes of the largest strongly connected component.
-  double best = 0;
-  std::vector<LaneGraphNodeId> lap;
-  for (size_t a = 0; a < graph.nodes.size(); ++a)
-    for (size_t b = a + 1; b < graph.nodes.size(); ++b) {
-      if (components.strong_of[a] != 0 || components.strong_of[b] != 0) continue;
-      const auto out =
-          shortest_route(graph, middle_of(graph, LaneGraphNodeId(a)), middle_of(graph, LaneGraphNodeId(b)));
-      const auto back =
-          shortest_route(graph, middle_of(graph, LaneGraphNodeId(b)), middle_of(graph, LaneGraphNodeId(a)));
-      if (out.front() != back.back() || back.front() != out.back()) continue;  // a bidirectional middle
-      const double length = route_length(graph, out) + route_length(graph, back);
-      if (length <= best) continue;
-      best = length;
-      lap = out;
-      lap.insert(lap.end(), back.begin() + 1, back.end() - 1);  // back to, not into, the first node
-    }
-  ASSERT_FALSE(lap.empty());
-  std::vector<LaneGraphNodeId> drive;
-  while (drive.empty() || route_length(graph, drive) < 1500) drive.insert(drive.end(), lap.begin(), lap.end());
-  drive.push_back(lap.front());
-  std::vector<Lanelet2Id> ids;
-  for (LaneGraphNodeId n : drive) ids.push_back(graph.nodes[n].lanelet);
-  // As a scenario's `route: {lanelets: [...]}`: the ids connect, and give the same drive.
-  const auto from_ids = route_from_lanelets(graph, ids);
-  const double length = route_length(graph, from_ids);
-  std::cout << "  lap of " << lap.size() << " lanelets, " << route_length(graph, lap) << " m to its start's end; drive "
-            << polyline_length(route_centreline(graph, from_ids)) << " m (" << length << " m by lanelets), "
-            << junctions_on(graph, from_ids) << " junctions, from " << describe_node(graph, lap.front()) << " at "
-            << middle_of(graph, lap.front()).transpose() << "; lap lanelets:";
-  for (LaneGraphNodeId n : lap) std::cout << " " << graph.nodes[n].lanelet;
-  std::cout << "\n";
+  const Scenario scenario = load_scenario(data + "/scenarios/karlsruhe.yaml");
+  const PathSpec& spec = scenario.ego.route;
+  const auto route = route_from_lanelets(graph, spec.lanelets, spec.u_turns);
+  const double length = route_length(graph, route);
+  const Polyline2d line = route_driven_line(graph, route);
+  // Curbstones within 10 m of the driven line (the detector looks 25 m out; a street's curbs are 3-6 m
+  // from its middle), sampled every metre.
+  std::vector<const Lanelet2LineString*> curbstones;
+  for (const auto& [id, l] : map.lines)
+    if (l.type == "curbstone") curbstones.push_back(&l);
+  int near = 0, samples = 0;
+  for (double s = 0; s < polyline_length(line); s += 1, ++samples) {
+    const Eigen::Vector2d p = sample_polyline(line, s).point;
+    const bool curb = std::any_of(curbstones.begin(), curbstones.end(), [&](const Lanelet2LineString* c) {
+      for (size_t i = 1; i < c->points.size(); ++i) {
+        const Eigen::Vector2d a = c->points[i - 1].head<2>(), b = c->points[i].head<2>();
+        const double t = std::clamp((p - a).dot(b - a) / std::max((b - a).squaredNorm(), 1e-12), 0.0, 1.0);
+        if ((a + t * (b - a) - p).norm() < 10) return true;
+      }
+      return false;
+    });
+    near += curb;
+  }
+  const long u_turns = std::count(route.begin(), route.end(), kUTurn);
+  std::cout << "  drive " << polyline_length(line) << " m (" << length << " m by lanelets), "
+            << junctions_on(graph, route) << " junctions, " << u_turns << " U-turns; a curbstone within 10 m along "
+            << 100.0 * near / samples << " % of it\n";
   EXPECT_GE(length, 1500);
-  EXPECT_GE(junctions_on(graph, from_ids), 10);
-  EXPECT_GE(polyline_length(route_centreline(graph, from_ids)), 1500);
+  EXPECT_GE(polyline_length(line), 1500);
+  EXPECT_GE(junctions_on(graph, route), 10);
+  EXPECT_GE(double(near) / samples, 0.8);
 }
 
 }  // namespace
