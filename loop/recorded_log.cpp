@@ -43,6 +43,10 @@ RecordedRun recorded_run(const McapReader& reader, const std::string& log) {
     vehicle = load_vehicle_params(*run.vehicle_from);
   }
   run.scenario = parse_scenario(run.scenario_text, run.scenario_name, vehicle, realism);
+  // A world named as a file is relative to the scenario's folder (load_scenario); the run recorded the
+  // path it resolved to, which the scenario's text alone cannot give.
+  if (names_a_world_file(run.scenario.world) && run.metadata.count("world"))
+    run.scenario.world = run.metadata.at("world");
   try {
     run.scenario.seed = std::stoull(run.metadata.at("seed"));
   } catch (const std::exception&) {
