@@ -201,10 +201,14 @@ struct Builder {
       const Polyline2d poly = st.polygon();
       for (const auto& p : poly) box.extend(p);
       if (poly.size() < 3) continue;
+      // Counter-clockwise, whichever side of the road the lane is on: Clipper's non-zero fill would
+      // cancel overlapping lanes of opposite turns (a junction's) into holes.
+      ClipperLib::Path path = region::to_path(poly);
+      if (!ClipperLib::Orientation(path)) ClipperLib::ReversePath(path);
       if (st.raised)
-        (st.lane->type == "curb" ? curb : walk).push_back(region::to_path(poly));
+        (st.lane->type == "curb" ? curb : walk).push_back(std::move(path));
       else
-        (st.road->junction == "-1" ? road : junctions[st.road->junction]).push_back(region::to_path(poly));
+        (st.road->junction == "-1" ? road : junctions[st.road->junction]).push_back(std::move(path));
     }
     // A junction's connecting roads overlap and leave islands between their turns that the map means
     // as pavement: each junction's lanes closed and without holes.
@@ -453,6 +457,7 @@ std::shared_ptr<const OpenDriveSource> load_opendrive_source(const std::string& 
   source->file = file;
   source->where = where;
   source->map = read_opendrive(file, read);
+  source->graph = build_opendrive_lane_graph(source->map);
   source->params = params;
   return source;
 }

@@ -40,6 +40,7 @@
 
 #include "sim/materials.hpp"
 #include "sim/opendrive_file.hpp"
+#include "sim/opendrive_lane_graph.hpp"
 #include "sim/world_builder.hpp"
 
 namespace lidarloop {
@@ -64,7 +65,7 @@ struct OdrWorldParams {
   double sliver_radius = 0.05;
   // A junction's connecting roads leave gaps between their turns narrower than twice this: closed, as
   // pavement (and any hole among them filled), m.
-  double junction_closing = 4.0;
+  double junction_closing = 1.0;
   // Sidewalks end where their roads meet a junction: gaps between them narrower than twice this (the
   // corners) are closed, as sidewalk, m.
   double sidewalk_closing = 2.5;
@@ -110,14 +111,17 @@ struct OdrBuildReport {
   std::string summary() const;  // several lines, for the CLI
 };
 
-// A world's road network from an OpenDRIVE map: the map as read and how to build it.
+// A world's road network from an OpenDRIVE map: the map as read, its routing graph (every route of the
+// ego, the traffic and the mapping drive is planned on it), and how to build it.
 struct OpenDriveSource {
   std::string file;   // the map, as the world names it
   std::string where;  // the world file's entry, file:line:col, for later errors
   OdrMap map;
+  OdrLaneGraph graph;
   OdrWorldParams params;
 };
 
+// Reads the map at `file` (sim/opendrive_file.hpp) and builds its routing graph once.
 std::shared_ptr<const OpenDriveSource> load_opendrive_source(const std::string& file, const std::string& where,
                                                              const OdrWorldParams& params,
                                                              const OdrReadOptions& read = {});

@@ -6,7 +6,6 @@
 #include "common/input_error.hpp"
 #include "sim/lane_graph.hpp"
 #include "sim/lanelet2_world.hpp"
-#include "sim/opendrive_lanes.hpp"
 #include "sim/opendrive_world.hpp"
 #include "sim/path.hpp"
 #include "sim/scenario.hpp"
@@ -70,11 +69,11 @@ Eigen::Isometry3d default_start_pose(const WorldDescription& description, double
     if (routes.empty()) throw InputError(description.lanelet2->file + ": the map has no lanelet a car can drive");
     return to_isometry(make_path(route_centreline(graph, routes.front()), false).pose_at(s));
   }
-  if (description.opendrive) {  // the longest driving lane
-    const auto paths = opendrive_driving_paths(description.opendrive->map);
-    if (paths.empty())
-      throw InputError(description.opendrive->file + ": the map has no driving lane outside junctions");
-    return to_isometry(make_path(paths.front().centreline, false).pose_at(s));
+  if (description.opendrive) {  // as on a Lanelet2 map
+    const LaneGraph& graph = description.opendrive->graph.graph;
+    const auto routes = covering_routes(graph);
+    if (routes.empty()) throw InputError(description.opendrive->file + ": the map has no lane a car can drive");
+    return to_isometry(make_path(route_centreline(graph, routes.front()), false).pose_at(s));
   }
   if (description.roads.empty()) throw InputError(description.file + ": the world has no road to start on");
   return to_isometry(lane_path(description.roads.front(), Lane::right, false).pose_at(s));
