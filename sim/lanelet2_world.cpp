@@ -16,6 +16,7 @@
 #include "common/points_kd_tree.hpp"
 #include "sim/actor_assets.hpp"
 #include "sim/curb_band.hpp"
+#include "sim/import_report.hpp"
 #include "sim/mesh_shapes.hpp"
 #include "sim/polyline.hpp"
 #include "sim/region.hpp"
@@ -1043,12 +1044,7 @@ std::string Lanelet2BuildReport::summary() const {
   o << "parking areas " << parking_areas << ": " << parked_vehicles << " parked vehicles in " << parking_stalls
     << " stalls\n";
   o << "traffic lights " << traffic_lights << ", traffic signs " << traffic_signs << "\n";
-  if (!not_built.empty()) {
-    o << "not built:";
-    for (const auto& [k, n] : not_built) o << " " << k << ": " << n << ";";
-    o << "\n";
-  }
-  for (const auto& w : warnings) o << "warning: " << w << "\n";
+  write_not_built(o, not_built, warnings);
   return o.str();
 }
 

@@ -8,6 +8,7 @@
 
 #include "common/input_error.hpp"
 #include "sim/actor_assets.hpp"
+#include "sim/import_report.hpp"
 #include "sim/opendrive_geometry.hpp"
 #include "sim/opendrive_paint.hpp"
 #include "sim/region.hpp"
@@ -422,12 +423,7 @@ std::string OdrBuildReport::summary() const {
   o << " crosswalks " << crosswalks << " (" << crosswalk_stripes << " stripes)\n";
   o << "parking: " << parked_vehicles << " parked vehicles in " << parking_stalls << " stalls; poles " << poles
     << ", buildings " << buildings << "\n";
-  if (!not_built.empty()) {
-    o << "not built:";
-    for (const auto& [k, n] : not_built) o << " " << k << ": " << n << ";";
-    o << "\n";
-  }
-  for (const auto& w : warnings) o << "warning: " << w << "\n";
+  write_not_built(o, not_built, warnings);
   return o.str();
 }
 
