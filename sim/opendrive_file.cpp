@@ -35,7 +35,9 @@ const OdrRoad* OdrMap::road(const std::string& id) const {
 
 namespace {
 
-constexpr int kFoldSamples = 64;  // tangents checked along a poly3 / paramPoly3 for folding back
+constexpr int kFoldSamples = 64;       // tangents checked along a poly3 / paramPoly3 for folding back
+constexpr double kMaxWidth = 1000;     // m: lane widths, borders and offsets beyond this are broken values
+constexpr double kMaxCurvature = 100;  // 1/m: a 1 cm radius
 
 // Messages name the file and line of the element, the road and the s where it went wrong.
 class Where {
@@ -158,7 +160,8 @@ OdrGeometry read_geometry(const Reader& r, const pugi::xml_node& n) {
   g.y = r.required(n, "y");
   g.hdg = r.required(n, "hdg");
   g.length = r.required(n, "length");
-  if (g.length < 0) r.where.fail(n, r.road, g.s, "geometry of negative length " + std::to_string(g.length));
+  if (g.length < 0 || g.length > 1e6)
+    r.where.fail(n, r.road, g.s, "geometry length " + std::to_string(g.length) + " m");
   const pugi::xml_node shape = n.first_child();
   const std::string kind = shape ? shape.name() : "";
   if (kind == "line") {
@@ -166,10 +169,13 @@ OdrGeometry read_geometry(const Reader& r, const pugi::xml_node& n) {
   } else if (kind == "arc") {
     g.kind = OdrGeometryKind::arc;
     g.curvature = r.required(shape, "curvature");
+    if (std::abs(g.curvature) > kMaxCurvature) r.where.fail(shape, r.road, g.s, "arc curvature beyond 100 1/m");
   } else if (kind == "spiral") {
     g.kind = OdrGeometryKind::spiral;
     g.curv_start = r.required(shape, "curvStart");
     g.curv_end = r.required(shape, "curvEnd");
+    if (std::abs(g.curv_start) > kMaxCurvature || std::abs(g.curv_end) > kMaxCurvature)
+      r.where.fail(shape, r.road, g.s, "spiral curvature beyond 100 1/m");
   } else if (kind == "poly3") {
     g.kind = OdrGeometryKind::poly3;
     g.a = r.number(shape, "a", 0), g.b = r.number(shape, "b", 0);
@@ -298,7 +304,7 @@ OdrObject read_object(const Reader& r, const pugi::xml_node& n) {
   o.radius = r.number(n, "radius", 0);
   o.height = r.number(n, "height", 0);
   if (o.length < 0 || o.width < 0 || o.radius < 0 || o.height < 0 || o.length > 1e4 || o.width > 1e4 ||
-      o.radius > 1e4 || o.height > 1e3)
+      o.radius > 1e4 || o.height > 1e3 || std::abs(o.t) > 1e4 || std::abs(o.z_offset) > 1e3)
     r.where.fail(n, r.road, o.s, "object " + quoted(o.id) + " has a negative or huge size");
   // OpenDRIVE 1.4 has one `outline` per object, 1.5 on an `outlines` list of them.
   std::vector<pugi::xml_node> outlines;
@@ -315,6 +321,9 @@ OdrObject read_object(const Reader& r, const pugi::xml_node& n) {
         corners.push_back(
             {r.required(c, "u"), r.required(c, "v"), r.number(c, "z", 0), r.number(c, "height", 0), false});
     }
+    for (const auto& c : corners)
+      if (std::abs(c.u) > 1e4 || std::abs(c.v) > 1e4 || std::abs(c.z) > 1e3 || std::abs(c.height) > 1e3)
+        r.where.fail(ol, r.road, o.s, "object " + quoted(o.id) + " has an outline corner beyond 10 km");
     if (!corners.empty()) o.outlines.push_back(std::move(corners));
   }
   return o;
@@ -392,6 +401,32 @@ OdrRoad read_road(const Where& where, const pugi::xml_node& n, double max_extent
                           "lane " + std::to_string(lane.id) + " width goes negative");
           }
         }
+  }
+  // Values a road cannot have (a fuzzed or corrupt file): they would overflow the world's integer
+  // geometry further on.
+  auto bounded = [&](const std::vector<OdrCubic>& records, double base, double end, double limit, const char* what) {
+    for (size_t k = 0; k < records.size(); ++k) {
+      const double s0 = std::max(base, records[k].s), s1 = k + 1 < records.size() ? records[k + 1].s : end;
+      for (int j = 0; j <= kFoldSamples && s1 >= s0; ++j) {
+        const double s = s0 + (s1 - s0) * j / kFoldSamples;
+        if (!(std::abs(records[k].at(s)) <= limit))
+          where.fail(n, road.id, s, std::string(what) + " beyond " + std::to_string(int(limit)) + " m");
+      }
+    }
+  };
+  bounded(road.elevation, 0, road.length, max_extent, "elevation");
+  bounded(road.lane_offset, 0, road.length, kMaxWidth, "laneOffset");
+  for (size_t i = 0; i < road.sections.size(); ++i)
+    for (const auto* side : {&road.sections[i].left, &road.sections[i].right})
+      for (const auto& lane : *side) {
+        const double length = road.section_end(i) - road.sections[i].s;
+        bounded(lane.width, 0, length, kMaxWidth, "lane width");
+        bounded(lane.border, 0, length, kMaxWidth, "lane border");
+      }
+  for (const auto& g : road.plan_view) {
+    const OdrPose end = geometry_pose(g, g.length);
+    if (!(std::hypot(end.x, end.y) <= max_extent) || !std::isfinite(end.hdg))
+      where.fail(n, road.id, g.s + g.length, "geometry ends beyond " + std::to_string(int(max_extent)) + " m");
   }
   for (const auto& o : n.child("objects").children("object")) road.objects.push_back(read_object(r, o));
   for (const auto& s : n.child("signals").children()) road.signals += std::string(s.name()) == "signal";

@@ -254,6 +254,9 @@ TEST(OpenDriveFile, BadInputIsOneLineNamingFileRoadAndS) {
        "paramPoly3 folds back"},
       {map_text(road("7", 10, "<line/>", "")), "road 7: no laneSection"},
       {map_text(road("7", 10, "<arc curvature=\"x\"/>", good_lanes)), "road 7: arc curvature is not a number: 'x'"},
+      {map_text(road("7", 10, "<arc curvature=\"1e9\"/>", good_lanes)), "road 7 at s=0: arc curvature beyond 100 1/m"},
+      {map_text(road("7", 10, "<line/>", section("", lane(-1, "driving", 1e9)))),
+       "road 7 at s=0: lane width beyond 1000 m"},
       {map_text(road("7", 10, "<line/>", good_lanes) +
                 "  <junction id=\"1\"><connection id=\"0\" incomingRoad=\"7\" connectingRoad=\"8\"/></junction>\n"),
        "road '8' is not in the map"},
