@@ -100,7 +100,7 @@ TEST(Scenario, MalformedScenariosAreRejectedWithTheirOwnMessage) {
       {"bad lane", edit("{road: loop, lane: right}", "{road: loop, lane: middle}"), "5:29",
        "lane must be right or left"},
       {"road and waypoints", edit("{road: loop, lane: right}", "{road: loop, waypoints: [[0, 0], [1, 1]]}"), "5:10",
-       "exactly one of 'road', 'waypoints', 'crosswalk', 'lanelets' or 'from' and 'to'"},
+       "exactly one of 'road', 'waypoints', 'crosswalk', 'lanelets', 'opendrive' or 'from' and 'to'"},
       {"stop without duration", edit("{at: 164, duration_s: 2}", "{at: 164}"), "8:11", "missing key 'duration_s'"},
       {"vehicle key", edit("{mass: 2000}", "{weight: 2000}"), "9:13", "unknown key 'weight'"},
       {"lidar out of range", edit("{rotation_hz: 20}", "{rotation_hz: 50}"), "10:22",
