@@ -54,11 +54,11 @@ static void hash_file(uint64_t& h, const std::string& path) {
   hash_bytes(h, s.str());
 }
 
-// The Lanelet2 map a world is made from, and the projector file beside it if there is one: a world.yaml
-// naming a map (`lanelet2: {file}`), or the map itself.
+// The Lanelet2 or OpenDRIVE map a world is made from, and the projector file beside it if there is one:
+// a world.yaml naming a map (`lanelet2: {file}`, `opendrive: {file}`), or the map itself.
 static std::vector<std::string> lanelet2_files(const std::string& world_path) {
   std::string map;
-  if (fs::path(world_path).extension() == ".osm") {
+  if (fs::path(world_path).extension() == ".osm" || fs::path(world_path).extension() == ".xodr") {
     map = world_path;
   } else {
     YAML::Node root;
@@ -67,8 +67,9 @@ static std::vector<std::string> lanelet2_files(const std::string& world_path) {
     } catch (const YAML::Exception&) {
       return {};  // loading the world reports what is wrong with its file
     }
-    if (!root.IsMap() || !root["lanelet2"] || !root["lanelet2"]["file"]) return {};
-    map = path_beside(world_path, root["lanelet2"]["file"].as<std::string>());
+    const char* key = root.IsMap() && root["opendrive"] ? "opendrive" : "lanelet2";
+    if (!root.IsMap() || !root[key] || !root[key]["file"]) return {};
+    map = path_beside(world_path, root[key]["file"].as<std::string>());
   }
   std::vector<std::string> files;
   if (map != world_path) files.push_back(map);

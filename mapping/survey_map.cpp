@@ -6,6 +6,7 @@
 
 #include "sim/lane_graph.hpp"
 #include "sim/lanelet2_world.hpp"
+#include "sim/opendrive_world.hpp"
 
 namespace lidarloop {
 
@@ -42,6 +43,15 @@ SurveyDrive plan_survey(const WorldDescription& d, const SurveyErrorConfig& conf
     const LaneGraph& graph = d.lanelet2->graph;
     for (const auto& route : covering_routes(graph)) {
       SurveyLane l{nullptr, false, make_path(route_driven_line(graph, route), false), drive.length_m, {}};
+      for (const auto& p : l.path.points) l.box.extend(p);
+      drive.length_m += l.path.length;
+      drive.lanes.push_back(std::move(l));
+    }
+  }
+  if (d.opendrive) {  // an OpenDRIVE map: the same, on its driving lanes through the junctions
+    const LaneGraph& graph = d.opendrive->graph.graph;
+    for (const auto& route : covering_routes(graph)) {
+      SurveyLane l{nullptr, false, make_path(route_centreline(graph, route), false), drive.length_m, {}};
       for (const auto& p : l.path.points) l.box.extend(p);
       drive.length_m += l.path.length;
       drive.lanes.push_back(std::move(l));

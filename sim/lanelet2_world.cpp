@@ -16,9 +16,11 @@
 #include "common/points_kd_tree.hpp"
 #include "sim/actor_assets.hpp"
 #include "sim/curb_band.hpp"
+#include "sim/import_report.hpp"
 #include "sim/mesh_shapes.hpp"
 #include "sim/polyline.hpp"
 #include "sim/region.hpp"
+#include "sim/scattered_heights.hpp"
 
 namespace lidarloop {
 namespace {
@@ -27,7 +29,6 @@ namespace {
 // over their midpoints finds the nearest piece among a few candidates.
 constexpr double kEdgePiece = 0.5;                        // m
 constexpr size_t kEdgeNeighbours = 12;                    // candidates per look-up
-constexpr size_t kTerrainNeighbours = 8;                  // points of known height blended for the terrain
 constexpr double kOnLine = 1e-4;                          // m: a point this close to a curb line is on its top
 constexpr double kRibbonMargin = 0.01;                    // m of curb top and of low ground meshed with the face
 constexpr double kSideProbe = 0.25;                       // m each side of a curbstone tested for the carriageway
@@ -202,37 +203,6 @@ class EdgeField {
     return out;
   }
   SegmentIndex index_;
-};
-
-// Heights known at scattered points, blended by modified Shepard weights (Franke & Nielson, 1980:
-// w = ((R - d)+ / (R d))^2 over the k nearest, R the distance of the next one), which, unlike plain
-// inverse distance weighting over k neighbours, stays continuous as the neighbours change.
-class ScatteredHeights {
- public:
-  ScatteredHeights(std::vector<Eigen::Vector2d> points, std::vector<double> z)
-      : points_(std::move(points)), z_(std::move(z)), tree_(&points_) {}
-  double operator()(const Eigen::Vector2d& p) const {
-    std::array<uint32_t, kTerrainNeighbours + 1> idx{};
-    std::array<double, kTerrainNeighbours + 1> d2{};
-    const size_t found = tree_.tree.knnSearch(p.data(), kTerrainNeighbours + 1, idx.data(), d2.data());
-    if (found == 0) return 0;
-    if (d2[0] < 1e-12) return z_[idx[0]];
-    const double radius =
-        found == kTerrainNeighbours + 1 ? std::sqrt(d2[found - 1]) : std::numeric_limits<double>::infinity();
-    double sw = 0, swz = 0;
-    for (size_t k = 0; k < std::min(found, kTerrainNeighbours); ++k) {
-      const double d = std::sqrt(d2[k]);
-      const double w = std::isinf(radius) ? 1 / (d * d) : std::pow(std::max(0.0, radius - d) / (radius * d), 2);
-      sw += w;
-      swz += w * z_[idx[k]];
-    }
-    return sw > 0 ? swz / sw : z_[idx[0]];
-  }
-
- private:
-  std::vector<Eigen::Vector2d> points_;
-  std::vector<double> z_;
-  PointsKdTree tree_;
 };
 
 // The raised ground's height above the terrain: each curb line gives its reveal on its raised side
@@ -1074,12 +1044,7 @@ std::string Lanelet2BuildReport::summary() const {
   o << "parking areas " << parking_areas << ": " << parked_vehicles << " parked vehicles in " << parking_stalls
     << " stalls\n";
   o << "traffic lights " << traffic_lights << ", traffic signs " << traffic_signs << "\n";
-  if (!not_built.empty()) {
-    o << "not built:";
-    for (const auto& [k, n] : not_built) o << " " << k << ": " << n << ";";
-    o << "\n";
-  }
-  for (const auto& w : warnings) o << "warning: " << w << "\n";
+  write_not_built(o, not_built, warnings);
   return o.str();
 }
 

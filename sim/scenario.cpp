@@ -10,6 +10,7 @@
 #include "common/yaml_reader.hpp"
 #include "sim/lane_graph.hpp"
 #include "sim/lanelet2_world.hpp"
+#include "sim/opendrive_world.hpp"
 #include "sim/region.hpp"
 #include "sim/world_assets.hpp"
 
@@ -78,11 +79,14 @@ PathSpec read_path(const YamlReader& y, const YAML::Node& n, const char* what) {
   PathSpec p;
   p.where = m.where();
   const YAML::Node road = m["road"], waypoints = m["waypoints"], crosswalk = m["crosswalk"];
-  // On a Lanelet2 map: the lanelets to drive, or a place to drive to (from `from`).
-  const YAML::Node lanelets = m["lanelets"], to = m["to"];
-  if (int(bool(road)) + int(bool(waypoints)) + int(bool(crosswalk)) + int(bool(lanelets)) + int(bool(to)) != 1)
-    y.fail(n,
-           std::string(what) + " needs exactly one of 'road', 'waypoints', 'crosswalk', 'lanelets' or 'from' and 'to'");
+  // On a Lanelet2 map: the lanelets to drive; on an OpenDRIVE map its lanes; on either a place to drive
+  // to (from `from`).
+  const YAML::Node lanelets = m["lanelets"], opendrive = m["opendrive"], to = m["to"];
+  if (int(bool(road)) + int(bool(waypoints)) + int(bool(crosswalk)) + int(bool(lanelets)) + int(bool(opendrive)) +
+          int(bool(to)) !=
+      1)
+    y.fail(n, std::string(what) +
+                  " needs exactly one of 'road', 'waypoints', 'crosswalk', 'lanelets', 'opendrive' or 'from' and 'to'");
   const YAML::Node lane = m["lane"], direction = m["direction"], offset = m["offset"];
   if (road) {
     p.kind = PathSpec::Kind::road;
@@ -119,6 +123,17 @@ PathSpec read_path(const YamlReader& y, const YAML::Node& n, const char* what) {
     if (p.lanelets.empty()) y.fail(lanelets, "a route needs at least one lanelet");
     if (!p.u_turns.empty() && p.u_turns.back() == p.lanelets.size())
       y.fail(lanelets, "a U-turn must come between two lanelets, not at the end");
+  }
+  if (opendrive) {
+    p.kind = PathSpec::Kind::opendrive;
+    y.expect_sequence(opendrive, "opendrive");
+    for (const auto& lane : opendrive) {
+      y.expect_sequence(lane, "a lane [road, lane]");
+      if (lane.size() != 2) y.fail(lane, "a lane is [road id, lane id]");
+      p.opendrive_lanes.emplace_back(y.string(lane[0], "a road id"),
+                                     int(y.integer_in(lane[1], "a lane id", -100, 100)));
+    }
+    if (p.opendrive_lanes.empty()) y.fail(opendrive, "a route needs at least one lane");
   }
   if (to) {
     p.kind = PathSpec::Kind::lanelets;
@@ -346,7 +361,29 @@ BuiltPath build_path(const PathSpec& p, const WorldDescription& d) {
       if (p.closed && (corners.front() - corners.back()).norm() < 0.01) corners.pop_back();
       return BuiltPath{make_path(fillet_polyline(corners, p.smoothing_radius, p.closed, 3 * kDeg), p.closed), {}};
     }
+    case PathSpec::Kind::opendrive:
+      if (!d.opendrive)
+        throw InputError(p.where + ": a route by OpenDRIVE lanes needs a world from an OpenDRIVE map; world '" +
+                         d.name + "' has none");
+      try {
+        const LaneGraph& graph = d.opendrive->graph.graph;
+        return BuiltPath{
+            make_path(route_centreline(graph, route_from_opendrive_lanes(d.opendrive->graph, p.opendrive_lanes)),
+                      false),
+            {}};
+      } catch (const InputError& e) {
+        throw InputError(p.where + ": " + e.what());
+      }
     case PathSpec::Kind::lanelets: {
+      if (d.opendrive && p.route_to) {
+        try {
+          const LaneGraph& graph = d.opendrive->graph.graph;
+          return BuiltPath{make_path(route_centreline(graph, shortest_route(graph, *p.route_from, *p.route_to)), false),
+                           {}};
+        } catch (const InputError& e) {
+          throw InputError(p.where + ": " + e.what());
+        }
+      }
       if (!d.lanelet2)
         throw InputError(p.where + ": a route by lanelets needs a world from a Lanelet2 map; world '" + d.name +
                          "' has roads");

@@ -25,7 +25,7 @@ namespace lidarloop {
 
 struct PathSpec {
   std::string where;
-  enum class Kind { road, waypoints, crosswalk, lanelets } kind = Kind::road;
+  enum class Kind { road, waypoints, crosswalk, lanelets, opendrive } kind = Kind::road;
   // kind == road: a lane of a road
   std::string road;
   Lane lane = Lane::right;
@@ -43,7 +43,10 @@ struct PathSpec {
   // each i in u_turns), or the shortest route between two points
   std::vector<int64_t> lanelets;
   std::vector<size_t> u_turns;
-  std::optional<Eigen::Vector2d> route_from, route_to;
+  std::optional<Eigen::Vector2d> route_from, route_to;  // on a Lanelet2 or an OpenDRIVE map
+  // kind == opendrive, on a world from an OpenDRIVE map (sim/opendrive_lane_graph.hpp): the lanes in
+  // driving order, as road id and lane id
+  std::vector<std::pair<std::string, int>> opendrive_lanes;
 };
 
 struct TrafficSpec {

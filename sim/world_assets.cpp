@@ -6,6 +6,7 @@
 #include "common/input_error.hpp"
 #include "sim/lane_graph.hpp"
 #include "sim/lanelet2_world.hpp"
+#include "sim/opendrive_world.hpp"
 #include "sim/path.hpp"
 #include "sim/scenario.hpp"
 
@@ -20,7 +21,8 @@ std::string actors_dir() { return data_dir() + "/assets/actors"; }
 
 bool names_a_world_file(const std::string& name_or_path) {
   const std::string extension = std::filesystem::path(name_or_path).extension().string();
-  return name_or_path.find('/') != std::string::npos || extension == ".yaml" || extension == ".osm";
+  return name_or_path.find('/') != std::string::npos || extension == ".yaml" || extension == ".osm" ||
+         extension == ".xodr";
 }
 
 std::string world_file(const std::string& name_or_path) {
@@ -37,8 +39,10 @@ std::string world_file(const std::string& name_or_path) {
 LoadedWorld load_world(const std::string& name_or_path) {
   MaterialTable materials = MaterialTable::load(data_dir() + "/assets/materials.yaml");
   const std::string file = world_file(name_or_path);
-  WorldDescription description = std::filesystem::path(file).extension() == ".osm" ? lanelet2_world_description(file)
-                                                                                   : load_world_description(file);
+  const std::string extension = std::filesystem::path(file).extension().string();
+  WorldDescription description = extension == ".osm"    ? lanelet2_world_description(file)
+                                 : extension == ".xodr" ? opendrive_world_description(file)
+                                                        : load_world_description(file);
   World world = build_world(description, materials, actors_dir());
   return {std::move(materials), std::move(description), std::move(world)};
 }
@@ -65,6 +69,13 @@ Eigen::Isometry3d default_start_pose(const WorldDescription& description, double
     if (routes.empty()) throw InputError(description.lanelet2->file + ": the map has no lanelet a car can drive");
     return to_isometry(make_path(route_driven_line(graph, routes.front()), false).pose_at(s));
   }
+  if (description.opendrive) {  // as on a Lanelet2 map
+    const LaneGraph& graph = description.opendrive->graph.graph;
+    const auto routes = covering_routes(graph);
+    if (routes.empty()) throw InputError(description.opendrive->file + ": the map has no lane a car can drive");
+    return to_isometry(make_path(route_centreline(graph, routes.front()), false).pose_at(s));
+  }
+  if (description.roads.empty()) throw InputError(description.file + ": the world has no road to start on");
   return to_isometry(lane_path(description.roads.front(), Lane::right, false).pose_at(s));
 }
 

@@ -11,6 +11,7 @@
 #include "sim/curb_band.hpp"
 #include "sim/lanelet2_world.hpp"
 #include "sim/mesh_shapes.hpp"
+#include "sim/opendrive_world.hpp"
 #include "sim/polyline.hpp"
 
 namespace lidarloop {
@@ -543,6 +544,16 @@ GroundHeight World::pavement() const {
 
 World build_world(const WorldDescription& description, const MaterialTable& materials, const std::string& actors_dir) {
   Builder b{description, materials, actors_dir, {}, {}};
+  if (description.opendrive) {  // as a Lanelet2 map's below
+    OdrBuildReport report;
+    b.world = build_opendrive_world(description.opendrive->map, description.opendrive->params, materials, actors_dir,
+                                    &report);
+    b.world.name = description.name;
+    b.world.import_report = report.summary();
+    b.build_buildings();
+    b.build_parked();
+    return std::move(b.world);
+  }
   if (description.lanelet2) {
     // The road network is the map's; what the world file adds stands on it.
     Lanelet2BuildReport report;

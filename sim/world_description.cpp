@@ -11,6 +11,7 @@
 #include "common/yaml_reader.hpp"
 #include "sim/actor_assets.hpp"
 #include "sim/lanelet2_world.hpp"
+#include "sim/opendrive_world.hpp"
 #include "sim/polyline.hpp"
 
 namespace lidarloop {
@@ -227,6 +228,31 @@ std::shared_ptr<const Lanelet2Source> read_lanelet2_source(const YamlReader& y, 
   }
 }
 
+// world.yaml's `opendrive` section: the map (a path relative to the world file) and what the map leaves
+// unsaid (sim/opendrive_world.hpp's OdrWorldParams). The world's `origin` is the map's x / y origin
+// where the map's geoReference is a placeholder.
+std::shared_ptr<const OpenDriveSource> read_opendrive_source(const YamlReader& y, const YAML::Node& n,
+                                                             const std::optional<Geodetic>& origin,
+                                                             const WorldGeometryParams& geometry) {
+  YamlMap m(y, n, "opendrive");
+  const YAML::Node file = m.required("file");
+  OdrWorldParams p;
+  p.geometry = geometry;
+  m.number("parking_occupancy", p.parking_occupancy, 0.0, 1.0)
+      .integer("seed", p.seed, 0, uint64_t(1) << 62)
+      .number("sidewalk_height", p.sidewalk_height, 0.0, 0.5)
+      .number("curb_threshold", p.curb_threshold, 0.005, 0.2)
+      .boolean("paint_junctions", p.paint_junctions);
+  m.done();
+  OdrReadOptions read;
+  read.origin = origin;
+  try {
+    return load_opendrive_source(path_beside(y.file(), y.string(file, "file")), m.where(), p, read);
+  } catch (const InputError& e) {
+    y.fail(file, e.what());
+  }
+}
+
 WorldDescription parse(const YamlReader& y) {
   YamlMap root(y, y.root(), "a world description");
   WorldDescription w;
@@ -234,8 +260,8 @@ WorldDescription parse(const YamlReader& y) {
   w.name = y.string(root.required("name"), "name");
 
   // A Lanelet2 map brings its own road network and, unless `origin` says otherwise, its own origin.
-  const YAML::Node lanelet2 = root["lanelet2"];
-  const YAML::Node origin_node = lanelet2 ? root["origin"] : root.required("origin");
+  const YAML::Node lanelet2 = root["lanelet2"], opendrive = root["opendrive"];
+  const YAML::Node origin_node = lanelet2 || opendrive ? root["origin"] : root.required("origin");
   if (origin_node) {
     YamlMap origin(y, origin_node, "origin");
     w.origin.lat_deg = y.number_in(origin.required("lat"), "lat", -85.0, 85.0);
@@ -278,6 +304,18 @@ WorldDescription parse(const YamlReader& y) {
   YamlMap road_defaults(y, root["road_defaults"], "road_defaults");
   read_road_properties(road_defaults, defaults);
   road_defaults.done();
+  if (lanelet2 && opendrive) y.fail(opendrive, "a world has either a lanelet2 or an opendrive map, not both");
+  if (opendrive) {
+    if (root["roads"]) y.fail(root["roads"], "a world has either roads or an opendrive map, not both");
+    for (const char* key :
+         {"road_defaults", "crosswalks", "stop_lines", "curb_cuts", "poles", "trees", "bollards", "hydrants", "hedges"})
+      if (root[key])
+        y.fail(root[key],
+               std::string(key) + " are placed along roads; a world from an opendrive map takes them from the map");
+    w.opendrive =
+        read_opendrive_source(y, opendrive, origin_node ? std::optional<Geodetic>(w.origin) : std::nullopt, w.geometry);
+    w.origin = w.opendrive->map.origin;
+  }
   if (lanelet2) {
     if (root["roads"]) y.fail(root["roads"], "a world has either roads or a lanelet2 map, not both");
     for (const char* key :
@@ -289,9 +327,9 @@ WorldDescription parse(const YamlReader& y) {
         read_lanelet2_source(y, lanelet2, origin_node ? std::optional<Geodetic>(w.origin) : std::nullopt, w.geometry);
     w.origin = w.lanelet2->map.origin;
   }
-  const YAML::Node roads = lanelet2 ? YAML::Node(YAML::NodeType::Sequence) : root.required("roads");
+  const YAML::Node roads = lanelet2 || opendrive ? YAML::Node(YAML::NodeType::Sequence) : root.required("roads");
   y.expect_sequence(roads, "roads");
-  if (roads.size() == 0 && !lanelet2) y.fail(roads, "a world needs at least one road");
+  if (roads.size() == 0 && !lanelet2 && !opendrive) y.fail(roads, "a world needs at least one road");
   for (const auto& n : roads) {
     RoadSpec road = read_road(y, n, defaults);
     if (w.road(road.name)) y.fail(n["name"], "road name '" + road.name + "' is used twice");
@@ -469,6 +507,15 @@ WorldDescription lanelet2_world_description(const std::string& osm_path) {
   w.file = osm_path;
   w.lanelet2 = load_lanelet2_source(osm_path, osm_path, {});
   w.origin = w.lanelet2->map.origin;
+  return w;
+}
+
+WorldDescription opendrive_world_description(const std::string& xodr_path) {
+  WorldDescription w;
+  w.name = std::filesystem::path(xodr_path).stem().string();
+  w.file = xodr_path;
+  w.opendrive = load_opendrive_source(xodr_path, xodr_path, {});
+  w.origin = w.opendrive->map.origin;
   return w;
 }
 

@@ -179,7 +179,8 @@ struct WorldGeometryParams {
   double max_superelevation = 0.04;
 };
 
-struct Lanelet2Source;  // sim/lanelet2_world.hpp
+struct Lanelet2Source;   // sim/lanelet2_world.hpp
+struct OpenDriveSource;  // sim/opendrive_world.hpp
 
 struct WorldDescription {
   std::string name, file;
@@ -202,6 +203,8 @@ struct WorldDescription {
   // The road network read from a Lanelet2 map instead of `roads` (world.yaml's `lanelet2`, or a map
   // file given as the world): roads, and everything placed along them, are then empty.
   std::shared_ptr<const Lanelet2Source> lanelet2;
+  // The same from an OpenDRIVE map (world.yaml's `opendrive`, or a .xodr file given as the world).
+  std::shared_ptr<const OpenDriveSource> opendrive;
 
   const RoadSpec* road(const std::string& name) const;
 };
@@ -209,6 +212,8 @@ struct WorldDescription {
 WorldDescription load_world_description(const std::string& path);
 // A world that is a Lanelet2 map and nothing else (`lidarloop world MAP.osm`), named after the file.
 WorldDescription lanelet2_world_description(const std::string& osm_path);
+// A world that is an OpenDRIVE map and nothing else (`lidarloop world MAP.xodr`), named after the file.
+WorldDescription opendrive_world_description(const std::string& xodr_path);
 // Today's world: `surveyed` (the world file, as the map was surveyed) changed by a scenario's
 // `world_changes` mapping: parked vehicles gone (their positions) or new, lane paint worn or
 // repainted, construction zones. Errors name the scenario's file:line:col.

@@ -4,6 +4,7 @@
 
 #include "sim/lanelet2_world.hpp"
 #include "sim/obj_file.hpp"
+#include "sim/opendrive_world.hpp"
 #include "sim/world_assets.hpp"
 #include "tools/commands.hpp"
 #include "tools/world_map_png.hpp"
@@ -22,7 +23,8 @@ static int run_world(const Args& args) {
             << "origin       " << w.world.origin.lat_deg << ", " << w.world.origin.lon_deg << " (WGS-84)\n"
             << "extent       " << size.x() << " m x " << size.y() << " m\n"
             << (w.description.lanelet2 ? "lanelets     " + std::to_string(w.description.lanelet2->map.lanelets.size())
-                                       : "roads        " + std::to_string(w.description.roads.size()))
+                : w.description.opendrive ? "roads        " + std::to_string(w.description.opendrive->map.roads.size())
+                                          : "roads        " + std::to_string(w.description.roads.size()))
             << "\n"
             << "curb lines   " << w.world.curbs.size() << " (" << curb_length << " m)\n"
             << "triangles    " << w.world.mesh.triangle_count() << "\n"
@@ -47,8 +49,9 @@ static int run_world(const Args& args) {
 
 Command world_command() {
   return {{"world",
-           "lidarloop world WORLD|MAP.osm [--obj FILE.obj] [--curbs FILE.geojson] [--png FILE.png]",
-           "Build a world (a name under maps/, a world.yaml path or a Lanelet2 map's .osm); print its size and\n"
+           "lidarloop world WORLD|MAP.osm|MAP.xodr [--obj FILE.obj] [--curbs FILE.geojson] [--png FILE.png]",
+           "Build a world (a name under maps/, a world.yaml path, a Lanelet2 map's .osm or an OpenDRIVE map's\n"
+           ".xodr); print its size and\n"
            "what it is made of, export mesh and curbs.",
            {{"obj", "FILE", "write the triangle mesh as Wavefront OBJ (one usemtl group per material)"},
             {"curbs", "FILE", "write the curb map as GeoJSON LineStrings in WGS-84"},

@@ -100,7 +100,7 @@ TEST(Scenario, MalformedScenariosAreRejectedWithTheirOwnMessage) {
       {"bad lane", edit("{road: loop, lane: right}", "{road: loop, lane: middle}"), "5:29",
        "lane must be right or left"},
       {"road and waypoints", edit("{road: loop, lane: right}", "{road: loop, waypoints: [[0, 0], [1, 1]]}"), "5:10",
-       "exactly one of 'road', 'waypoints', 'crosswalk', 'lanelets' or 'from' and 'to'"},
+       "exactly one of 'road', 'waypoints', 'crosswalk', 'lanelets', 'opendrive' or 'from' and 'to'"},
       {"stop without duration", edit("{at: 164, duration_s: 2}", "{at: 164}"), "8:11", "missing key 'duration_s'"},
       {"u_turn first", edit("{road: loop, lane: right}", "{lanelets: [u_turn, 7]}"), "5:22",
        "a U-turn must come between two lanelets"},
