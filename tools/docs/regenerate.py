@@ -360,42 +360,54 @@ def target_sweep(r, commands):
 
 
 KARLSRUHE_OSM = "../shared/data/maps/lanelet2/karlsruhe_mapping_example.osm"
+OPENDRIVE_MAPS = "../shared/data/maps/opendrive"
 
 
-def target_lanelet2(r, commands):
-    if not os.path.isfile(os.path.join(ROOT, KARLSRUHE_OSM)):
-        raise Failure(f"{KARLSRUHE_OSM} not found: the Karlsruhe map is read from the shared data folder beside the clone")
-    cache = fresh(os.path.join(WORK, "maps-cache-karlsruhe"))
+def map_world_figures(r, commands, name, map_file, world_yaml, scenario):
+    """A world read from an outside map: build it, survey its HD map from an empty cache, run its scenario
+    in open and closed loop and compare every method on it; the figures as markdown."""
+    if not os.path.isfile(os.path.join(ROOT, map_file)):
+        raise Failure(f"{map_file} not found: the map is read from the shared data folder beside the clone")
+    cache = fresh(os.path.join(WORK, f"maps-cache-{name}"))
     env = {"LIDARLOOP_MAP_CACHE": cache}
-    built, world_s, world_mb, shown = r.run(["lidarloop", "world", KARLSRUHE_OSM])
+    built, world_s, world_mb, shown = r.run(["lidarloop", "world", map_file])
     commands.append(shown)
-    mapped, map_s, map_mb, shown = r.run(["lidarloop", "map", "maps/karlsruhe/world.yaml"], env=env)
+    mapped, map_s, map_mb, shown = r.run(["lidarloop", "map", world_yaml], env=env)
     commands.append(shown)
     rows = []
     for loop in ("open", "closed"):
-        out = fresh(os.path.join(WORK, "karlsruhe", loop))
-        _, _, _, shown = r.run(["lidarloop", "run", "scenarios/karlsruhe.yaml", "--loop", loop, "--out", out],
-                               env=env, ok=(0, 1))
+        out = fresh(os.path.join(WORK, name, loop))
+        _, _, _, shown = r.run(["lidarloop", "run", scenario, "--loop", loop, "--out", out], env=env, ok=(0, 1))
         commands.append(shown)
         m = json.loads(read(os.path.join(out, "metrics.json")))
         rows.append(f"| {loop} | {num(m.get('lateral_rmse_m'))} | {num(m.get('longitudinal_rmse_m'))} | "
                     f"{num(m.get('heading_rmse_deg'))} | {num(m.get('max_position_error_m'))} | "
                     f"{num(m.get('max_lane_offset_m'))} | {'PASS' if m.get('pass') else 'FAIL'} |")
-    out = fresh(os.path.join(WORK, "karlsruhe", "compare"))
-    _, _, _, shown = r.run(["lidarloop", "compare", "scenarios/karlsruhe.yaml", "--methods", "all", "--out", out],
-                           env=env, ok=(0, 1))
+    out = fresh(os.path.join(WORK, name, "compare"))
+    _, _, _, shown = r.run(["lidarloop", "compare", scenario, "--methods", "all", "--out", out], env=env, ok=(0, 1))
     commands.append(shown)
     comparison = read(os.path.join(out, "comparison.md")).strip()
-    return {"lanelet2": (
+    return (
         f"Reading and building the world took {duration_text(world_s)} of wall time, peak resident memory "
         f"{world_mb:.0f} MB; what `world` printed:\n\n```text\n{built.strip()}\n```\n\n"
         f"Its HD map from an empty cache took {duration_text(map_s)}, peak {map_mb:.0f} MB:\n\n"
         f"```text\n{mapped.strip()}\n```\n\n"
-        f"`scenarios/karlsruhe.yaml` (the proposed method) in open and closed loop:\n\n"
+        f"`{scenario}` (the proposed method) in open and closed loop:\n\n"
         f"| loop | lateral RMSE m | longitudinal RMSE m | heading RMSE deg | worst error m | "
         f"farthest from the lane's centre m | result |\n"
         f"|---|---:|---:|---:|---:|---:|---|\n" + "\n".join(rows) + "\n\n"
-        f"Every method on the same drive (`compare --methods all`):\n\n{comparison}\n")}
+        f"Every method on the same drive (`compare --methods all`):\n\n{comparison}\n")
+
+
+def target_lanelet2(r, commands):
+    return {"lanelet2": map_world_figures(r, commands, "karlsruhe", KARLSRUHE_OSM, "maps/karlsruhe/world.yaml",
+                                          "scenarios/karlsruhe.yaml")}
+
+
+def target_opendrive(r, commands):
+    return {name: map_world_figures(r, commands, name, f"{OPENDRIVE_MAPS}/{xodr}", f"maps/{name}/world.yaml",
+                                    f"scenarios/{name}.yaml")
+            for name, xodr in (("town01", "Town01.xodr"), ("fabriksgatan", "fabriksgatan.xodr"))}
 
 
 TARGETS = {
@@ -414,6 +426,8 @@ TARGETS = {
               "bench lidar, bench localizer and bench loop (short runs)"),
     "lanelet2": (target_lanelet2, {"lanelet2": "docs/lanelet2-worlds.md"},
                  "the Karlsruhe Lanelet2 map: its world, its HD map, its scenario in open and closed loop, compare"),
+    "opendrive": (target_opendrive, {"town01": "docs/opendrive-worlds.md", "fabriksgatan": "docs/opendrive-worlds.md"},
+                  "CARLA's Town01 and esmini's fabriksgatan: each world, HD map, scenario open and closed, compare"),
     "sweep": (target_sweep, {"sweep": "docs/sweeps.md"},
               "a 16-run bus occlusion sweep (tools/docs/bus_occlusion_docs.yaml) and its plots"),
 }
