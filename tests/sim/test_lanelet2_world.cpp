@@ -302,9 +302,8 @@ TEST(Lanelet2World, KarlsruheCurbsAreTheFilesCurbstones) {
   EXPECT_EQ(w.curbs.size(), 325u);
   EXPECT_NEAR(built, ways, 0.01 * ways);
   EXPECT_EQ(report.road_lanelets + report.cycle_tracks, 337 + 8 + 14);
-  std::cout << report.summary() << w.mesh.triangle_count()
-            << " triangles; " << w.bounds.sizes().transpose() << " m; carriageway " << region::area(w.carriageway)
-            << " m2\n";
+  std::cout << report.summary() << w.mesh.triangle_count() << " triangles; " << w.bounds.sizes().transpose()
+            << " m; carriageway " << region::area(w.carriageway) << " m2\n";
 }
 
 }  // namespace
