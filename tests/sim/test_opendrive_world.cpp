@@ -1,6 +1,7 @@
 // A world from an OpenDRIVE map (sim/opendrive_world.hpp), on small maps written inline whose geometry
 // is known (a straight town street along +x), the project's small town, and the real maps from
 // ../shared (esmini's fabriksgatan, CARLA's Town01) when they are there.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -10,6 +11,7 @@
 #include "common/input_error.hpp"
 #include "sim/actor_assets.hpp"
 #include "sim/lane_graph.hpp"
+#include "sim/lidar_scanner.hpp"
 #include "sim/opendrive_world.hpp"
 #include "sim/polyline.hpp"
 #include "sim/ray_scene.hpp"
@@ -206,6 +208,48 @@ TEST(OpenDriveWorld, FabriksgatanCurbsStandAtTheFilesHeight) {
     }
   }
   EXPECT_GT(checked, 50);
+}
+
+// What the localizer is given: a scan. A noiseless HDL-32E on the carriageway, 2.5 m from the middle of
+// each of fabriksgatan's longest curb lines, heading along it: the points on the sidewalk just behind the
+// curb stand the file's 0.12 m above those on the carriageway just in front.
+TEST(OpenDriveWorld, FabriksgatanScanShowsItsSidewalkCurbsAtTheFilesHeight) {
+  if (!std::filesystem::exists(kShared + "fabriksgatan.xodr")) GTEST_SKIP() << kShared << " not there";
+  const World w = build(read_opendrive(kShared + "fabriksgatan.xodr"), smooth_params());
+  std::vector<const Polyline2d*> lines;
+  for (const auto& c : w.curbs) lines.push_back(&c);
+  std::sort(lines.begin(), lines.end(),
+            [](const Polyline2d* a, const Polyline2d* b) { return polyline_length(*a) > polyline_length(*b); });
+  ASSERT_GE(lines.size(), 2u);
+  RayScene scene(w.mesh);
+  const Hdl32eConfig config = test::noiseless_hdl32e();
+  const LidarScanner scanner(config, test::materials());
+  for (size_t k = 0; k < 2; ++k) {
+    const Polyline2d& curb = *lines[k];
+    const PolylineSample q = sample_polyline(curb, polyline_length(curb) / 2);
+    const Eigen::Vector2d out(q.tangent.y(), -q.tangent.x());  // towards the sidewalk
+    const Eigen::Vector2d at = q.point - 2.5 * out;
+    const auto ground = down(scene, at.x(), at.y());
+    ASSERT_TRUE(ground && ground->second != material("sidewalk")) << at.transpose();
+    const Eigen::Isometry3d vehicle = Eigen::Translation3d(at.x(), at.y(), ground->first) *
+                                      Eigen::AngleAxisd(std::atan2(q.tangent.y(), q.tangent.x()), Eigen::Vector3d::UnitZ());
+    const PointCloud cloud = scanner.scan(scene, constant_twist(vehicle, 0, 0, 0), 0, 1);
+    const Eigen::Isometry3d sensor = vehicle * config.mount();
+    std::vector<double> road, sidewalk;
+    for (const auto& p : cloud.points) {
+      const Eigen::Vector3d x = sensor * test::fired_point(p, config);
+      const Eigen::Vector2d d = x.head<2>() - q.point;
+      if (std::abs(d.dot(q.tangent)) > 4 || x.z() > ground->first + 0.5) continue;  // this stretch, the ground
+      const double across = d.dot(out);
+      if (across > -1.5 && across < -0.3) road.push_back(x.z());
+      if (across > 0.1 && across < 0.8) sidewalk.push_back(x.z());
+    }
+    ASSERT_GT(road.size(), 30u) << "curb " << k;
+    ASSERT_GT(sidewalk.size(), 30u) << "curb " << k;
+    std::sort(road.begin(), road.end());
+    std::sort(sidewalk.begin(), sidewalk.end());
+    EXPECT_NEAR(sidewalk[sidewalk.size() / 2] - road[road.size() / 2], 0.12, 0.01) << "curb " << k;
+  }
 }
 
 TEST(OpenDriveWorld, Town01BuildsWithJunctionsAndSidewalks) {
