@@ -231,8 +231,9 @@ TEST(OpenDriveWorld, FabriksgatanScanShowsItsSidewalkCurbsAtTheFilesHeight) {
     const Eigen::Vector2d at = q.point - 2.5 * out;
     const auto ground = down(scene, at.x(), at.y());
     ASSERT_TRUE(ground && ground->second != material("sidewalk")) << at.transpose();
-    const Eigen::Isometry3d vehicle = Eigen::Translation3d(at.x(), at.y(), ground->first) *
-                                      Eigen::AngleAxisd(std::atan2(q.tangent.y(), q.tangent.x()), Eigen::Vector3d::UnitZ());
+    const Eigen::Isometry3d vehicle =
+        Eigen::Translation3d(at.x(), at.y(), ground->first) *
+        Eigen::AngleAxisd(std::atan2(q.tangent.y(), q.tangent.x()), Eigen::Vector3d::UnitZ());
     const PointCloud cloud = scanner.scan(scene, constant_twist(vehicle, 0, 0, 0), 0, 1);
     const Eigen::Isometry3d sensor = vehicle * config.mount();
     std::vector<double> road, sidewalk;
