@@ -167,9 +167,10 @@ MapLocation ensure_map(const std::string& world_name, const MappingOptions& opti
   const std::string world_path = world_file(world_name);
   MapLocation loc;
   loc.hash = map_hash(world_name, options);
-  const LoadedWorld w = load_mapped_world(world_path, options);
+  // The world is named by its description; it is built only when its map must be.
+  const std::string name = load_world_description_of(world_path).name;
   const std::string root = map_cache_root();
-  loc.dir = root + "/" + w.world.name + "-" + loc.hash;
+  loc.dir = root + "/" + name + "-" + loc.hash;
   // A map in its place is always whole (see move_into_place): reading it needs no lock.
   if (!force && cached_map_matches(loc)) return loc;
 
@@ -180,11 +181,12 @@ MapLocation ensure_map(const std::string& world_name, const MappingOptions& opti
   // One builder per map at a time, across processes; the others wait here, then find its map.
   const FileLock lock(loc.dir + ".lock", [&] {
     if (!terminal) return;
-    std::printf("waiting for another process's build of the %s map (%s.lock)\n", w.world.name.c_str(), loc.dir.c_str());
+    std::printf("waiting for another process's build of the %s map (%s.lock)\n", name.c_str(), loc.dir.c_str());
     std::fflush(stdout);
   });
   if (!force && cached_map_matches(loc)) return loc;
   remove_stale_builds(loc.dir);
+  const LoadedWorld w = load_mapped_world(world_path, options);
 
   const auto t0 = std::chrono::steady_clock::now();
   const std::string tmp = make_build_dir(loc.dir);

@@ -65,12 +65,9 @@ MappingOptions mapping_options_for(Realism realism) {
 }
 
 LoadedWorld load_mapped_world(const std::string& world, const MappingOptions& options) {
-  LoadedWorld w = load_world(world);
-  if (options.ideal_ground) {
-    w.description = on_ideal_ground(std::move(w.description));
-    w.world = build_world(w.description, w.materials, actors_dir());
-  }
-  return w;
+  WorldDescription description = load_world_description_of(world);
+  if (options.ideal_ground) description = on_ideal_ground(std::move(description));
+  return build_loaded_world(std::move(description));
 }
 
 void read_survey_options(const YamlReader& yaml, const YAML::Node& node, MappingOptions& o) {

@@ -36,30 +36,34 @@ std::string world_file(const std::string& name_or_path) {
   return path;
 }
 
-LoadedWorld load_world(const std::string& name_or_path) {
-  MaterialTable materials = MaterialTable::load(data_dir() + "/assets/materials.yaml");
+WorldDescription load_world_description_of(const std::string& name_or_path) {
   const std::string file = world_file(name_or_path);
   const std::string extension = std::filesystem::path(file).extension().string();
-  WorldDescription description = extension == ".osm"    ? lanelet2_world_description(file)
-                                 : extension == ".xodr" ? opendrive_world_description(file)
-                                                        : load_world_description(file);
+  return extension == ".osm"    ? lanelet2_world_description(file)
+         : extension == ".xodr" ? opendrive_world_description(file)
+                                : load_world_description(file);
+}
+
+LoadedWorld build_loaded_world(WorldDescription description) {
+  MaterialTable materials = MaterialTable::load(data_dir() + "/assets/materials.yaml");
   World world = build_world(description, materials, actors_dir());
   return {std::move(materials), std::move(description), std::move(world)};
 }
 
+LoadedWorld load_world(const std::string& name_or_path) {
+  return build_loaded_world(load_world_description_of(name_or_path));
+}
+
 LoadedWorld load_scenario_world(const Scenario& scenario) {
-  LoadedWorld w = load_world(scenario.world);
+  WorldDescription description = load_world_description_of(scenario.world);
   // The `ideal` profile drives (and maps) the world on ideal ground: flat roads, ideal curbs.
-  const bool ideal = scenario.realism == Realism::ideal;
-  if (ideal) w.description = on_ideal_ground(std::move(w.description));
-  bool changed = false;
+  if (scenario.realism == Realism::ideal) description = on_ideal_ground(std::move(description));
   if (!scenario.text.empty()) {
     const YamlReader y = YamlReader::from_string(scenario.text, scenario.file);
     const YAML::Node changes = y.root().IsMap() ? y.root()["world_changes"] : YAML::Node();
-    if (changes) w.description = apply_world_changes(std::move(w.description), y, changes), changed = true;
+    if (changes) description = apply_world_changes(std::move(description), y, changes);
   }
-  if (ideal || changed) w.world = build_world(w.description, w.materials, actors_dir());
-  return w;
+  return build_loaded_world(std::move(description));
 }
 
 Eigen::Isometry3d default_start_pose(const WorldDescription& description, double s) {

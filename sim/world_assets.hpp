@@ -21,7 +21,12 @@ struct LoadedWorld {
   WorldDescription description;
   World world;
 };
+// The description alone (a world YAML file, a Lanelet2 .osm or an OpenDRIVE .xodr), without building
+// its mesh: enough to name the world or to change it before it is built.
+WorldDescription load_world_description_of(const std::string& name_or_path);
 LoadedWorld load_world(const std::string& name_or_path);
+// The materials and the world built from `description` (built once: change the description first).
+LoadedWorld build_loaded_world(WorldDescription description);
 
 struct Scenario;
 // The world a scenario drives in today: its world file (as the map was surveyed) with the scenario's
