@@ -1,6 +1,7 @@
 #include "sim/region.hpp"
 
 #include <cmath>
+#include <unordered_map>
 
 namespace lidarloop::region {
 
@@ -34,17 +35,30 @@ Paths square(cInt x0, cInt y0, cInt size) {
   return {{{x0, y0}, {x0 + size, y0}, {x0 + size, y0 + size}, {x0, y0 + size}}};
 }
 
+struct IntPointHash {
+  size_t operator()(const IntPoint& p) const { return std::hash<cInt>()(p.X * 1000003 + p.Y); }
+};
+
 struct Mesher {
   const std::function<float(const Eigen::Vector2d&)>& height;
   MaterialId material;
   TriangleMesh& mesh;
   cInt leaf_size, min_size, max_square;
+  // Each inner corner of the grid is a corner of four squares: its height (a sum of sinusoids and a
+  // nearest-road search) is worked out once. The same point gives the same bits either way.
+  std::unordered_map<IntPoint, float, IntPointHash> heights{};
+
+  float height_at(const IntPoint& p) {
+    const auto [it, added] = heights.try_emplace(p, 0.0f);
+    if (added) it->second = height(to_metres(p));
+    return it->second;
+  }
 
   void emit(const Path& polygon) {
     const auto base = static_cast<uint32_t>(mesh.vertices.size());
     for (const auto& p : polygon) {
       const Eigen::Vector2d xy = to_metres(p);
-      mesh.vertices.emplace_back(float(xy.x()), float(xy.y()), height(xy));
+      mesh.vertices.emplace_back(float(xy.x()), float(xy.y()), height_at(p));
     }
     for (const auto& t : triangulate_polygon(polygon))
       mesh.add_triangle(base + t[0], base + t[1], base + t[2], material);
