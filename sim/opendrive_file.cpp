@@ -35,9 +35,11 @@ const OdrRoad* OdrMap::road(const std::string& id) const {
 
 namespace {
 
-constexpr int kFoldSamples = 64;       // tangents checked along a poly3 / paramPoly3 for folding back
-constexpr double kMaxWidth = 1000;     // m: lane widths, borders and offsets beyond this are broken values
-constexpr double kMaxCurvature = 100;  // 1/m: a 1 cm radius
+constexpr int kFoldSamples = 64;          // tangents checked along a poly3 / paramPoly3 for folding back
+constexpr double kMaxWidth = 1000;        // m: lane widths, borders and offsets beyond this are broken values
+constexpr double kMaxRepeatLength = 1e5;  // m: an object's repeat longer than this is a broken value
+constexpr int kMaxRepeatCopies = 10000;   // copies of one repeated object: more is a broken distance
+constexpr double kMaxCurvature = 100;     // 1/m: a 1 cm radius
 
 // Messages name the file and line of the element, the road and the s where it went wrong.
 class Where {
@@ -329,6 +331,52 @@ OdrObject read_object(const Reader& r, const pugi::xml_node& n) {
   return o;
 }
 
+// An object with `repeat` records (street lights every 30 m, delineators, bollards): one copy every
+// `distance` metres over `length`, its t, size and height moved linearly from each Start to each End
+// value, as the standard has it. A repeat of distance 0 is one continuous object (a railing, a wall):
+// not built, so the object stays one and says so in its type; the builder names it.
+void read_object_and_repeats(const Reader& r, const pugi::xml_node& n, std::vector<OdrObject>& out) {
+  const OdrObject o = read_object(r, n);
+  bool repeated = false;
+  for (const auto& rep : n.children("repeat")) {
+    repeated = true;
+    const double s0 = r.required(rep, "s"), length = r.required(rep, "length"), distance = r.required(rep, "distance");
+    if (length < 0 || distance < 0 || length > kMaxRepeatLength)
+      r.where.fail(rep, r.road, s0, "object " + quoted(o.id) + " repeats over a negative or huge length");
+    if (distance == 0) {
+      OdrObject c = o;
+      c.s = s0;
+      c.type = "continuous " + (o.type.empty() ? std::string("object") : o.type);
+      out.push_back(std::move(c));
+      continue;
+    }
+    if (length / distance > kMaxRepeatCopies)
+      r.where.fail(rep, r.road, s0,
+                   "object " + quoted(o.id) + " repeats more than " + std::to_string(kMaxRepeatCopies) + " times");
+    // Each attribute from its Start to its End value; the object's own where the record gives none.
+    auto ramp = [&](const char* start, const char* end, double own, double f) {
+      const double a = r.number(rep, start, own), b = r.number(rep, end, a);
+      return a + f * (b - a);
+    };
+    for (int k = 0; k * distance <= length + 1e-9; ++k) {
+      const double f = length > 0 ? k * distance / length : 0.0;
+      OdrObject c = o;
+      c.s = s0 + k * distance;
+      c.t = ramp("tStart", "tEnd", o.t, f);
+      c.z_offset = ramp("zOffsetStart", "zOffsetEnd", o.z_offset, f);
+      c.width = ramp("widthStart", "widthEnd", o.width, f);
+      c.length = ramp("lengthStart", "lengthEnd", o.length, f);
+      c.height = ramp("heightStart", "heightEnd", o.height, f);
+      c.radius = ramp("radiusStart", "radiusEnd", o.radius, f);
+      for (auto& outline : c.outlines)
+        for (auto& corner : outline)
+          if (corner.road_frame) corner.u += c.s - o.s;  // cornerRoad's s moves with the copy
+      out.push_back(std::move(c));
+    }
+  }
+  if (!repeated) out.push_back(o);
+}
+
 std::optional<OdrLink> read_link(const pugi::xml_node& n) {
   if (!n) return std::nullopt;
   return OdrLink{n.attribute("elementType").value(), n.attribute("elementId").value(),
@@ -428,7 +476,7 @@ OdrRoad read_road(const Where& where, const pugi::xml_node& n, double max_extent
     if (!(std::hypot(end.x, end.y) <= max_extent) || !std::isfinite(end.hdg))
       where.fail(n, road.id, g.s + g.length, "geometry ends beyond " + std::to_string(int(max_extent)) + " m");
   }
-  for (const auto& o : n.child("objects").children("object")) road.objects.push_back(read_object(r, o));
+  for (const auto& o : n.child("objects").children("object")) read_object_and_repeats(r, o, road.objects);
   for (const auto& s : n.child("signals").children()) road.signals += std::string(s.name()) == "signal";
   return road;
 }

@@ -208,6 +208,39 @@ TEST(OpenDriveFile, ReadsMarksObjectsJunctionsAndTheOrigin) {
   EXPECT_EQ(map.road("2")->junction, "100");
 }
 
+TEST(OpenDriveFile, RepeatedObjectsAreOneCopyEveryDistanceAndAContinuousOneIsNamed) {
+  // Street lights every 10 m from s = 2 over 30 m, moving out from t = -5 to -8 and growing from 4 to
+  // 7 m: four copies, at s = 2, 12, 22, 32. A railing repeated continuously (distance 0) stays one.
+  const std::string objects =
+      "    <objects><object id=\"1\" type=\"pole\" s=\"2\" t=\"-5\" radius=\"0.1\" height=\"4\">"
+      "<repeat s=\"2\" length=\"30\" distance=\"10\" tStart=\"-5\" tEnd=\"-8\" heightStart=\"4\" "
+      "heightEnd=\"7\" zOffsetStart=\"0\" zOffsetEnd=\"0\"/></object>"
+      "<object id=\"2\" type=\"railing\" s=\"0\" t=\"6\"><repeat s=\"0\" length=\"40\" distance=\"0\" "
+      "tStart=\"6\" tEnd=\"6\"/></object></objects>\n";
+  const OdrMap map = parse_opendrive(map_text(road("1", 40, "<line/>", kOneLane, objects)), "t.xodr");
+  const auto& o = map.roads[0].objects;
+  ASSERT_EQ(o.size(), 5u);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(o[k].type, "pole");
+    EXPECT_DOUBLE_EQ(o[k].s, 2 + 10 * k);
+    EXPECT_DOUBLE_EQ(o[k].t, -5 - k);
+    EXPECT_DOUBLE_EQ(o[k].height, 4 + k);
+    EXPECT_DOUBLE_EQ(o[k].radius, 0.1);  // no radiusStart: the object's own
+  }
+  EXPECT_EQ(o[4].type, "continuous railing");
+  // A distance that would make millions of copies is an error at its line, not a hang.
+  const std::string flood =
+      "    <objects><object id=\"3\" type=\"pole\" s=\"0\"><repeat s=\"0\" length=\"40\" "
+      "distance=\"0.00001\"/></object></objects>\n";
+  try {
+    parse_opendrive(map_text(road("1", 40, "<line/>", kOneLane, flood)), "t.xodr");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("t.xodr:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("repeats more than 10000 times"), std::string::npos) << e.what();
+  }
+}
+
 TEST(OpenDriveFile, PlaceholderGeoReferenceTakesTheWorldsOrigin) {
   OdrReadOptions options;
   options.origin = Geodetic{48.1, 11.5, 0};
