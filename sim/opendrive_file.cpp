@@ -397,6 +397,10 @@ OdrRoad read_road(const Where& where, const pugi::xml_node& n, double max_extent
         "length " + std::to_string(road.length) + " m is not above 0 and below " + std::to_string(max_extent) + " m");
   const std::string junction = n.attribute("junction").value();
   road.junction = junction.empty() ? "-1" : junction;
+  const std::string rule = n.attribute("rule").value();
+  if (rule != "" && rule != "RHT" && rule != "LHT")
+    where.fail(n, road.id, std::nullopt, "rule " + quoted(rule) + " is neither RHT nor LHT");
+  road.left_hand_traffic = rule == "LHT";
   road.predecessor = read_link(n.child("link").child("predecessor"));
   road.successor = read_link(n.child("link").child("successor"));
   if (const auto t = n.child("type")) road.type = t.attribute("type").value();

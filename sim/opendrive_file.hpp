@@ -108,6 +108,9 @@ struct OdrObject {
 
 struct OdrRoad {
   std::string id, name, junction = "-1";  // junction: "-1" for a road outside any
+  // rule="LHT" (OpenDRIVE 1.5+): the lanes left of the reference line are driven along s. Right-hand
+  // traffic (the right lanes along s) where the road does not say.
+  bool left_hand_traffic = false;
   double length = 0;
   std::optional<OdrLink> predecessor, successor;
   std::string type;  // the first `type` record's type (town, rural, motorway, ...)
@@ -122,6 +125,8 @@ struct OdrRoad {
   // Index of the section that holds s.
   size_t section_at(double s) const;
   double section_end(size_t i) const { return i + 1 < sections.size() ? sections[i + 1].s : length; }
+  // Whether lane `lane_id` is driven in the direction of increasing s.
+  bool along_s(int lane_id) const { return (lane_id < 0) != left_hand_traffic; }
 };
 
 struct OdrLaneLink {

@@ -55,12 +55,15 @@ struct Builder {
               const double s = s0 + (s1 - s0) * j / k;
               const OdrLaneEdges e = lane_edges(road, i, lane.id, s);
               widest = std::max(widest, std::abs(e.outer - e.inner));
-              n.left_bound.push_back(road_point(road, s, e.inner).head<2>());
-              n.right_bound.push_back(road_point(road, s, e.outer).head<2>());
+              // Driven along s, the edge at the larger t is on the left.
+              const bool inner_on_left = road.along_s(lane.id) == (e.inner > e.outer);
+              const double left_t = inner_on_left ? e.inner : e.outer, right_t = inner_on_left ? e.outer : e.inner;
+              n.left_bound.push_back(road_point(road, s, left_t).head<2>());
+              n.right_bound.push_back(road_point(road, s, right_t).head<2>());
               n.centreline.push_back(road_point(road, s, 0.5 * (e.inner + e.outer)).head<2>());
             }
             if (widest < kMinWidth) continue;
-            if (lane.id > 0)  // driven against s
+            if (!road.along_s(lane.id))
               for (auto* line : {&n.left_bound, &n.right_bound, &n.centreline})
                 std::reverse(line->begin(), line->end());
             n.length = polyline_length(n.centreline);
@@ -78,7 +81,7 @@ struct Builder {
           for (const auto& lane : *side)
             if (const auto n = node(road.id, i, lane.id)) out.nodes_of[{road.id, lane.id}].push_back(*n);
     for (auto& [ref, ids] : out.nodes_of)
-      if (ref.second > 0) std::reverse(ids.begin(), ids.end());
+      if (!map.road(ref.first)->along_s(ref.second)) std::reverse(ids.begin(), ids.end());
   }
 
   void connect(LaneGraphNodeId from, std::optional<LaneGraphNodeId> to) {
@@ -107,7 +110,7 @@ struct Builder {
           for (const auto& lane : *side) {
             const auto self = node(road.id, i, lane.id);
             if (!self) continue;
-            const bool forward = lane.id < 0;
+            const bool forward = road.along_s(lane.id);
             // The next section long enough to drive, in the direction of travel, following the lane
             // links through the short ones between (editors leave sections of centimetres); at the
             // road's end, the lane there and its link onwards.
@@ -148,16 +151,19 @@ struct Builder {
                 }
               }
             }
-            // Neighbours: the next lane outwards is on the right in the direction of travel.
+            // Neighbours: driven along s, the lane at the next smaller t (id - 1) is on the right. The
+            // centre (id 0) is never crossed: the lanes beyond it go the other way. A lane change
+            // crosses the mark on the outer edge of the lane nearer the centre.
             LaneGraphNode& n = out.graph.nodes[size_t(*self)];
-            const int outward = lane.id < 0 ? lane.id - 1 : lane.id + 1;
-            const int inward = lane.id < 0 ? lane.id + 1 : lane.id - 1;
-            if (const auto r = node(road.id, i, outward)) n.right = *r, n.can_change_right = crossable(lane);
-            if (inward != 0)
-              if (const auto l = node(road.id, i, inward)) {
-                n.left = *l;
-                n.can_change_left = crossable(*road.sections[i].lane(inward));
-              }
+            const int right = forward ? lane.id - 1 : lane.id + 1, left = forward ? lane.id + 1 : lane.id - 1;
+            auto mark_between = [&](int other) -> const OdrLane& {
+              return std::abs(other) < std::abs(lane.id) ? *road.sections[i].lane(other) : lane;
+            };
+            if (right != 0)
+              if (const auto r = node(road.id, i, right))
+                n.right = *r, n.can_change_right = crossable(mark_between(right));
+            if (left != 0)
+              if (const auto l = node(road.id, i, left)) n.left = *l, n.can_change_left = crossable(mark_between(left));
           }
   }
 };

@@ -330,8 +330,8 @@ struct Builder {
       for (int k = 0; k < n; ++k) {
         const double s = first + (k + 0.5) * params.stall_length;
         const OdrLaneEdges e = lane_edges(*st.road, st.section, st.lane->id, s);
-        // Cars face the way the lane's side drives (right-hand traffic: left lanes against s).
-        const double heading = reference_pose(*st.road, s).hdg + (st.lane->id > 0 ? M_PI : 0.0);
+        // Cars face the way the lane's side drives.
+        const double heading = reference_pose(*st.road, s).hdg + (st.road->along_s(st.lane->id) ? 0.0 : M_PI);
         stalls.push_back({road_point(*st.road, s, 0.5 * (e.inner + e.outer)).head<2>(), heading, false});
       }
     }

@@ -333,6 +333,41 @@ TEST(OpenDriveLaneGraph, LanesFollowThroughTheJunctionAndRoutesAreChecked) {
   }
 }
 
+TEST(OpenDriveLaneGraph, LeftHandTrafficDrivesTheLeftLanesAlongS) {
+  // A 50 m street along +x with two lanes each way, rule="LHT": lanes 1 and 2 are driven along s
+  // (towards +x), with the kerbside lane 2 on their left; lanes -1 and -2 against it.
+  const std::string lanes =
+      section(lane(1, "driving", 3.5) + lane(2, "driving", 3.5), lane(-1, "driving", 3.5) + lane(-2, "driving", 3.5));
+  std::string text = map_text(road("1", 50, "<line/>", lanes));
+  const std::string plain = "<road id=\"1\"";
+  text.replace(text.find(plain), plain.size(), "<road rule=\"LHT\" id=\"1\"");
+  const OdrMap map = parse_opendrive(text, "lht.xodr");
+  ASSERT_TRUE(map.roads[0].left_hand_traffic);
+  const OdrLaneGraph g = build_opendrive_lane_graph(map);
+  auto node = [&](int id) -> const LaneGraphNode& { return g.graph.nodes[size_t(g.nodes_of.at({"1", id}).front())]; };
+  EXPECT_LT(node(1).centreline.front().x(), 1);
+  EXPECT_GT(node(1).centreline.back().x(), 49);
+  EXPECT_NEAR(node(1).centreline.front().y(), 1.75, 1e-9);
+  EXPECT_NEAR(node(1).left_bound.front().y(), 3.5, 1e-9);  // the outer edge is on the left
+  EXPECT_NEAR(node(1).right_bound.front().y(), 0, 1e-9);
+  EXPECT_GT(node(-1).centreline.front().x(), 49);
+  EXPECT_NEAR(node(-1).left_bound.front().y(), -3.5, 1e-9);
+  ASSERT_TRUE(node(1).left.has_value());
+  EXPECT_EQ(*node(1).left, g.nodes_of.at({"1", 2}).front());
+  EXPECT_FALSE(node(1).right.has_value());  // across the centre line: the other way
+  ASSERT_TRUE(node(-1).left.has_value());
+  EXPECT_EQ(*node(-1).left, g.nodes_of.at({"1", -2}).front());
+  std::string bad = text;
+  bad.replace(bad.find("LHT"), 3, "XYZ");
+  try {
+    parse_opendrive(bad, "lht.xodr");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("lht.xodr:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("rule 'XYZ' is neither RHT nor LHT"), std::string::npos) << e.what();
+  }
+}
+
 TEST(OpenDriveLaneGraph, Town01IsOneNetwork) {
   if (!std::filesystem::exists(kShared + "Town01.xodr")) GTEST_SKIP() << kShared << " not there";
   const OdrMap map = read_opendrive(kShared + "Town01.xodr");
