@@ -7,6 +7,9 @@
 #include <sstream>
 #include <string_view>
 
+#include <GeographicLib/Constants.hpp>
+#include <GeographicLib/TransverseMercator.hpp>
+#include <GeographicLib/UTMUPS.hpp>
 #include <pugixml.hpp>
 
 #include "common/input_error.hpp"
@@ -511,19 +514,77 @@ std::optional<double> proj_value(const std::string& proj, const std::string& key
   return std::nullopt;
 }
 
-// The origin from the geoReference, or the reason it is a placeholder.
-void read_geo_reference(OdrMap& map, const OdrReadOptions& options) {
-  const auto lat = proj_value(map.geo_reference, "lat_0"), lon = proj_value(map.geo_reference, "lon_0");
-  const bool usable = lat && lon && std::abs(*lat) <= 85 && std::abs(*lon) <= 180 && (*lat != 0 || *lon != 0);
-  if (usable && !options.override_origin) {
-    map.origin = {*lat, *lon, 0};
-    map.origin_from_map = true;
-    if (map.geo_reference.find("+proj=") != std::string::npos &&
-        map.geo_reference.find("+proj=tmerc") == std::string::npos)
-      map.warnings.push_back("geoReference " + quoted(map.geo_reference) +
-                             " is not a transverse Mercator: its lat_0 / lon_0 taken as the origin of a local one");
-    return;
+bool proj_flag(const std::string& proj, const std::string& flag) {
+  std::istringstream in(proj);
+  std::string token;
+  while (in >> token)
+    if (token == "+" + flag) return true;
+  return false;
+}
+
+// The header's <offset>: takes a point of the map's frame to the projection's (rotate by hdg, then add).
+struct HeaderOffset {
+  double x = 0, y = 0, hdg = 0;
+};
+
+// Where the map's (0, 0) is on the earth, from the geoReference's PROJ string and the header's offset;
+// or the reason it cannot be said. The map's x / y are then taken as east / north about that point.
+std::optional<Geodetic> map_origin(OdrMap& map, const HeaderOffset& off) {
+  const std::string& proj = map.geo_reference;
+  const auto lat = proj_value(proj, "lat_0"), lon = proj_value(proj, "lon_0");
+  if (proj.find("+proj=utm") != std::string::npos) {
+    const auto zone = proj_value(proj, "zone");
+    // The zone's false easting is 500 km: a map at easting 0 has no offset (a placeholder).
+    if (!zone || *zone < 1 || *zone > 60 || std::floor(*zone) != *zone || !(off.x > 0 && off.x < 1e6) ||
+        !(std::abs(off.y) < 1e7))
+      return std::nullopt;
+    double lat_deg = 0, lon_deg = 0;
+    try {
+      GeographicLib::UTMUPS::Reverse(int(*zone), !proj_flag(proj, "south"), off.x, off.y, lat_deg, lon_deg);
+    } catch (const GeographicLib::GeographicErr&) {
+      return std::nullopt;  // a northing outside the zone
+    }
+    double x = 0, y = 0, gamma = 0, k = 0;
+    GeographicLib::TransverseMercator::UTM().Forward(6.0 * *zone - 183, lat_deg,  // the zone's central meridian
+                                                     lon_deg, x, y, gamma, k);
+    std::ostringstream o;
+    o.precision(3);
+    o << "geoReference " << quoted(proj) << ": the map's x / y are UTM grid metres, taken as east / north at its "
+      << "origin; there grid north is " << std::fixed << std::abs(gamma) << " deg from true north, so a point 1 km "
+      << "away is placed " << std::abs(gamma) * M_PI / 180 * 1000 << " m off on the earth (its place in the world "
+      << "is exact)";
+    map.warnings.push_back(o.str());
+    return Geodetic{lat_deg, lon_deg, 0};
   }
+  const bool usable = lat && lon && std::abs(*lat) <= 85 && std::abs(*lon) <= 180 && (*lat != 0 || *lon != 0);
+  if (!usable) return std::nullopt;
+  if (proj.find("+proj=") != std::string::npos && proj.find("+proj=tmerc") == std::string::npos)
+    map.warnings.push_back("geoReference " + quoted(proj) +
+                           " is not a transverse Mercator: its lat_0 / lon_0 taken as the origin of a local one");
+  // The map's (0, 0) in metres east and north of the projection's origin.
+  const double east = off.x - proj_value(proj, "x_0").value_or(0), north = off.y - proj_value(proj, "y_0").value_or(0);
+  if (east == 0 && north == 0) return Geodetic{*lat, *lon, 0};
+  if (std::abs(east) > 1e6 || std::abs(north) > 1e6) return std::nullopt;
+  const double k0 = proj_value(proj, "k_0").value_or(proj_value(proj, "k").value_or(1.0));
+  const GeographicLib::TransverseMercator tm(GeographicLib::Constants::WGS84_a(), GeographicLib::Constants::WGS84_f(),
+                                             k0 > 0 ? k0 : 1.0);
+  double x0 = 0, y0 = 0, lat_deg = 0, lon_deg = 0;
+  tm.Forward(*lon, *lat, *lon, x0, y0);
+  tm.Reverse(*lon, east, y0 + north, lat_deg, lon_deg);
+  return Geodetic{lat_deg, lon_deg, 0};
+}
+
+// The origin from the geoReference, or the reason it is a placeholder.
+void read_geo_reference(OdrMap& map, const OdrReadOptions& options, const HeaderOffset& off) {
+  if (off.hdg != 0)
+    map.warnings.push_back("header offset hdg " + std::to_string(off.hdg) +
+                           " rad not applied: the map's x axis is taken as east");
+  if (!options.override_origin)
+    if (const auto origin = map_origin(map, off)) {
+      map.origin = *origin;
+      map.origin_from_map = true;
+      return;
+    }
   map.origin = options.origin.value_or(Geodetic{});
   if (options.override_origin) return;
   std::ostringstream o;
@@ -561,10 +622,8 @@ OdrMap parse(const std::string& xml, const std::string& name, const OdrReadOptio
   const pugi::xml_node geo = header.child("geoReference");
   map.geo_reference = geo.child_value();
   if (map.geo_reference.empty()) map.geo_reference = geo.text().get();
-  read_geo_reference(map, options);
-  if (const auto off = header.child("offset"))
-    if (r.number(off, "x", 0) != 0 || r.number(off, "y", 0) != 0 || r.number(off, "hdg", 0) != 0)
-      map.warnings.push_back("header offset ignored: the map's x / y are used as written");
+  const pugi::xml_node offset = header.child("offset");
+  read_geo_reference(map, options, {r.number(offset, "x", 0), r.number(offset, "y", 0), r.number(offset, "hdg", 0)});
 
   for (const auto& n : root.children("road")) {
     map.roads.push_back(read_road(where, n, options.max_extent_m));

@@ -253,6 +253,40 @@ TEST(OpenDriveFile, PlaceholderGeoReferenceTakesTheWorldsOrigin) {
   }
 }
 
+TEST(OpenDriveFile, GeoReferenceAndHeaderOffsetPlaceTheMapsOrigin) {
+  // The header's offset takes the map's (0, 0) to the projection's (offset.x, offset.y).
+  auto with_offset = [](const std::string& geo, double x, double y) {
+    std::string text = map_text(road("1", 10, "<line/>", kOneLane), geo);
+    text.replace(text.find("  </header>"), 0,
+                 "    <offset x=\"" + num(x) + "\" y=\"" + num(y) + "\" z=\"0\" hdg=\"0\"/>\n");
+    return parse_opendrive(text, "t.xodr");
+  };
+  // 1 km east of lat 49, lon 8 on a transverse Mercator centred there: 1000 m / (N cos(lat)) of
+  // longitude, N = a / sqrt(1 - e^2 sin^2(lat)) = 6,390,330 m, so 0.013667 deg, on the same parallel.
+  const OdrMap east = with_offset("+proj=tmerc +lat_0=49 +lon_0=8 +k=1 +x_0=0 +y_0=0", 1000, 0);
+  EXPECT_TRUE(east.origin_from_map);
+  EXPECT_NEAR(east.origin.lat_deg, 49, 1e-6);
+  EXPECT_NEAR(east.origin.lon_deg, 8.013667, 2e-6);
+  // UTM zone 32 north: easting 500 km is its central meridian, 9 deg east, where the northing is 0.9996
+  // of the meridian arc from the equator (Helmert's series on WGS84, solved here by bisection).
+  const OdrMap utm = with_offset("+proj=utm +zone=32 +ellps=WGS84 +units=m +no_defs", 500000, 5427000);
+  EXPECT_TRUE(utm.origin_from_map);
+  EXPECT_NEAR(utm.origin.lon_deg, 9, 1e-9);
+  const double a = 6378137, f = 1 / 298.257223563, e2 = f * (2 - f), e4 = e2 * e2, e6 = e4 * e2;
+  auto arc = [&](double phi) {
+    return a * ((1 - e2 / 4 - 3 * e4 / 64 - 5 * e6 / 256) * phi -
+                (3 * e2 / 8 + 3 * e4 / 32 + 45 * e6 / 1024) * std::sin(2 * phi) +
+                (15 * e4 / 256 + 45 * e6 / 1024) * std::sin(4 * phi) - (35 * e6 / 3072) * std::sin(6 * phi));
+  };
+  double lo = 0.8, hi = 0.9;
+  for (int k = 0; k < 60; ++k) (0.9996 * arc((lo + hi) / 2) < 5427000 ? lo : hi) = (lo + hi) / 2;
+  EXPECT_NEAR(utm.origin.lat_deg, lo * 180 / M_PI, 1e-7);
+  ASSERT_EQ(utm.warnings.size(), 1u);
+  EXPECT_NE(utm.warnings[0].find("UTM grid metres"), std::string::npos) << utm.warnings[0];
+  // UTM without an offset puts the map at easting 0, outside any zone: a placeholder.
+  EXPECT_FALSE(with_offset("+proj=utm +zone=32", 0, 0).origin_from_map);
+}
+
 // The message of the InputError that parsing `text` throws.
 std::string error_of(const std::string& text) {
   try {
