@@ -226,6 +226,11 @@ OdrRoadMark read_mark(const Reader& r, const pugi::xml_node& n) {
   m.type = n.attribute("type").value();
   m.weight = n.attribute("weight").value();
   m.color = n.attribute("color").value();
+  m.lane_change = n.attribute("laneChange").value();
+  if (!m.lane_change.empty() && m.lane_change != "increase" && m.lane_change != "decrease" && m.lane_change != "both" &&
+      m.lane_change != "none")
+    r.where.fail(n, r.road, std::nullopt,
+                 "roadMark laneChange " + quoted(m.lane_change) + " is not increase, decrease, both or none");
   m.width = r.maybe(n, "width");
   if (m.width && (*m.width < 0 || *m.width > 5))
     r.where.fail(n, r.road, std::nullopt, "roadMark width " + std::to_string(*m.width) + " m is not 0 to 5 m");

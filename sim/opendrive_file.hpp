@@ -66,6 +66,9 @@ struct OdrRoadMark {
   std::string color;               // standard, white, yellow, ...
   std::optional<double> width;     // m
   std::vector<OdrMarkLine> lines;  // the explicit pattern, when the mark gives one
+  // laneChange: "increase" (allowed towards the larger lane id), "decrease", "both", "none"; "" when the
+  // mark does not say (then its type says).
+  std::string lane_change;
 };
 
 struct OdrLane {

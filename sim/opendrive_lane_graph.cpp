@@ -20,11 +20,16 @@ bool drivable(const OdrLane& lane) {
   return std::any_of(std::begin(kTypes), std::end(kTypes), [&](const char* t) { return lane.type == t; });
 }
 
-// Marks a car may cross (ASAM OpenDRIVE 1.8 11.8: broken lines; no mark at all).
-bool crossable(const OdrLane& lane) {
+// Whether a car in lane `from` may cross `lane`'s mark (on its outer edge) into lane `to`: as the mark's
+// laneChange says, else by its type (ASAM OpenDRIVE 1.8 11.8: broken lines; no mark at all).
+bool crossable(const OdrLane& lane, int from, int to) {
   if (lane.marks.empty()) return true;
-  const std::string& t = lane.marks.front().type;
-  return t == "broken" || t == "broken broken" || t == "botts dots" || t == "none";
+  const OdrRoadMark& m = lane.marks.front();
+  if (m.lane_change == "both") return true;
+  if (m.lane_change == "none") return false;
+  if (m.lane_change == "increase") return to > from;
+  if (m.lane_change == "decrease") return to < from;
+  return m.type == "broken" || m.type == "broken broken" || m.type == "botts dots" || m.type == "none";
 }
 
 struct Builder {
@@ -161,9 +166,10 @@ struct Builder {
             };
             if (right != 0)
               if (const auto r = node(road.id, i, right))
-                n.right = *r, n.can_change_right = crossable(mark_between(right));
+                n.right = *r, n.can_change_right = crossable(mark_between(right), lane.id, right);
             if (left != 0)
-              if (const auto l = node(road.id, i, left)) n.left = *l, n.can_change_left = crossable(mark_between(left));
+              if (const auto l = node(road.id, i, left))
+                n.left = *l, n.can_change_left = crossable(mark_between(left), lane.id, left);
           }
   }
 };

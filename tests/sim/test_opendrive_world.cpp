@@ -368,6 +368,25 @@ TEST(OpenDriveLaneGraph, LeftHandTrafficDrivesTheLeftLanesAlongS) {
   }
 }
 
+TEST(OpenDriveLaneGraph, LaneChangeFollowsTheMarksLaneChangeOverItsType) {
+  // Two lanes along s; between them lane -1's solid mark with laneChange="increase": a car may move from
+  // lane -2 to lane -1 (towards the larger id), not back. Without laneChange, solid forbids both.
+  auto graph_with = [](const std::string& lane_change) {
+    const std::string mark = "            <roadMark sOffset=\"0\" type=\"solid\" width=\"0.12\"" + lane_change + "/>\n";
+    return build_opendrive_lane_graph(parse_opendrive(
+        map_text(road("1", 50, "<line/>", section("", lane(-1, "driving", 3.5, mark) + lane(-2, "driving", 3.5)))),
+        "t.xodr"));
+  };
+  const OdrLaneGraph g = graph_with(" laneChange=\"increase\"");
+  const LaneGraphNode& inner = g.graph.nodes[size_t(g.nodes_of.at({"1", -1}).front())];
+  const LaneGraphNode& outer = g.graph.nodes[size_t(g.nodes_of.at({"1", -2}).front())];
+  ASSERT_TRUE(inner.right && outer.left);
+  EXPECT_FALSE(inner.can_change_right);
+  EXPECT_TRUE(outer.can_change_left);
+  const OdrLaneGraph solid = graph_with("");
+  EXPECT_FALSE(solid.graph.nodes[size_t(solid.nodes_of.at({"1", -2}).front())].can_change_left);
+}
+
 TEST(OpenDriveLaneGraph, Town01IsOneNetwork) {
   if (!std::filesystem::exists(kShared + "Town01.xodr")) GTEST_SKIP() << kShared << " not there";
   const OdrMap map = read_opendrive(kShared + "Town01.xodr");
