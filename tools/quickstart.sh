@@ -51,7 +51,8 @@ if [ -f build-sanitize/CMakeCache.txt ] && ! grep -q '^CMAKE_CXX_COMPILER:[A-Z]*
   rm -rf build-sanitize
 fi
 configure build-sanitize -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
-  -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=ON -DLIDARLOOP_FUZZ=ON -DLIDARLOOP_BUILD_BENCHMARKS=OFF
+  -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=ON -DLIDARLOOP_FUZZ=ON -DLIDARLOOP_BUILD_BENCHMARKS=OFF \
+  -DLIDARLOOP_UNITY_BUILD=OFF
 cmake --build build-sanitize -j "$jobs" --target unit_tests fuzz_targets
 expect_tests build-sanitize unit fuzz
 # Left out here, run in the pass above only, each because a shorter test runs the same code
