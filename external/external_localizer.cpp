@@ -107,7 +107,12 @@ LocalizerEstimate ExternalLocalizer::on_scan(const PointCloud& cloud) {
     case ChildProcess::LineStatus::line:
       break;
     case ChildProcess::LineStatus::timed_out: {
-      char text[128];
+      // The usual cause is not a slow program but an answer that sits in its stdout buffer: a pipe is
+      // not a terminal, so Python, C's stdio and Node's streams buffer it until the buffer fills.
+      const std::string pending = child_.unread_output().empty()
+                                      ? ""
+                                      : " (it wrote " + quoted_excerpt(child_.unread_output()) + " without a newline)";
+      char text[160];
       if (first)
         std::snprintf(text, sizeof text,
                       "no answer within the startup timeout (%.1f s, localizer.external.startup_timeout_s)",
@@ -115,7 +120,11 @@ LocalizerEstimate ExternalLocalizer::on_scan(const PointCloud& cloud) {
       else
         std::snprintf(text, sizeof text, "no answer within the %.0f ms deadline (localizer.external.deadline_ms)",
                       params_.external.deadline_ms);
-      fail(text, &cloud);
+      fail(std::string(text) + pending +
+               ": does the program flush stdout after each answer? (Python: print(..., flush=True); C: "
+               "fflush(stdout); a pipe is not a terminal, so the output is buffered)" +
+               (first ? "; raise the timeout only if its start-up is slow" : ""),
+           &cloud);
     }
     case ChildProcess::LineStatus::too_long:
       fail("answer longer than 64 KiB: " + quoted_excerpt(child_.unread_output()), &cloud);
@@ -139,7 +148,9 @@ LocalizerEstimate ExternalLocalizer::parse_answer(const std::string& line, const
   try {
     answer = nlohmann::json::parse(line);
   } catch (const nlohmann::json::exception&) {
-    fail("answer is not JSON: " + quoted_excerpt(line), &cloud);
+    fail("answer is not JSON: " + quoted_excerpt(line) +
+             ": stdout carries the answers only, one JSON object per line; write logs to stderr",
+         &cloud);
   }
   if (!answer.is_object()) fail("answer is not a JSON object: " + quoted_excerpt(line), &cloud);
   const std::string where = "answer " + quoted_excerpt(line);
