@@ -62,7 +62,8 @@ int run_replay(const Args& args) {
   const std::string& recorded_method = run.method;
   std::optional<std::string> method = args.value("method");
   if (!method && !recorded_method.empty()) method = recorded_method;
-  const LocalizerParams params = localizer_params_for(scenario, method);
+  LocalizerParams params = localizer_params_for(scenario, method);
+  apply_deadline_option(args, params);
   const std::string name = std::filesystem::path(run.scenario_name).stem().string();
   const std::string out = args.text("out", "out/" + name + "-replay");
   prepare_output_dir(out);  // before the replay, not after it
@@ -147,6 +148,7 @@ Command replay_command() {
        "against the recorded ground truth, with the recorded scenario's thresholds. With the recorded\n"
        "method, the estimates are the live run's, bit for bit. Exit codes as for run.",
        {{"method", "NAME", "localizer method, or exec:PROGRAM ARGS (default: the recorded one, else the scenario's)"},
+        {"deadline-ms", "MS", "an exec: localizer's per-scan deadline (default: the recorded scenario's, else 100)"},
         {"out", "DIR", "output folder (default out/<scenario name>-replay)"}},
        1,
        1},

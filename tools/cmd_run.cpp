@@ -77,7 +77,8 @@ int run_run(const Args& args) {
     if (*loop != "open" && *loop != "closed") throw InputError("--loop must be open or closed, got '" + *loop + "'");
     s.scenario.closed_loop = *loop == "closed";
   }
-  const LocalizerParams params = localizer_params_for(s.scenario, args.value("method"));
+  LocalizerParams params = localizer_params_for(s.scenario, args.value("method"));
+  apply_deadline_option(args, params);
   const std::string name = std::filesystem::path(s.scenario.file).stem().string();
   const std::string out = args.text("out", "out/" + name);
   // Every output is opened before the map and the run: one that cannot be written fails at once.
@@ -160,9 +161,12 @@ int expect_best(const std::vector<Metrics>& metrics, const std::string& method) 
 
 // Every method on one simulated drive of `s` (its own seed); each method's files under `out`.
 std::vector<Metrics> compare_once(const LoadedScenario& s, const std::vector<std::string>& methods, int threads,
-                                  const std::string& out, size_t& scans) {
+                                  const std::string& out, size_t& scans, const Args& args) {
   std::vector<LocalizerParams> params;
-  for (const auto& m : methods) params.push_back(localizer_params_for(s.scenario, m));
+  for (const auto& m : methods) {
+    params.push_back(localizer_params_for(s.scenario, m));
+    apply_deadline_option(args, params.back());
+  }
   const std::string name = std::filesystem::path(s.scenario.file).stem().string();
   prepare_output_dir(out);
   HdMap map = open_scenario_map(s.scenario, s.world);
@@ -207,7 +211,7 @@ int run_compare(const Args& args) {
 
   if (!args.value("seeds")) {
     size_t scans = 0;
-    const std::vector<Metrics> metrics = compare_once(s, methods, threads, out, scans);
+    const std::vector<Metrics> metrics = compare_once(s, methods, threads, out, scans, args);
     std::cout << comparison_markdown(metrics);
     if (paper) std::cout << "\n" << paper_comparison_markdown(*paper, summarise_over_seeds(metrics));
     std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n",
@@ -227,7 +231,7 @@ int run_compare(const Args& args) {
     s.scenario.seed = seed;
     size_t scans = 0;
     const std::vector<Metrics> metrics =
-        compare_once(s, methods, threads, out + "/seed_" + std::to_string(seed), scans);
+        compare_once(s, methods, threads, out + "/seed_" + std::to_string(seed), scans, args);
     all.insert(all.end(), metrics.begin(), metrics.end());
     std::printf("seed %-5llu %zu scans:", (unsigned long long)seed, scans);
     for (const Metrics& m : metrics)
@@ -267,6 +271,7 @@ Command run_command() {
             {"seed", "N", "override the scenario's seed"},
             {"realism", "PROFILE", "ideal, typical or harsh: replaces the scenario's realism profile"},
             {"duration", "S", "override the scenario's duration, seconds"},
+            {"deadline-ms", "MS", "an exec: localizer's per-scan deadline (default: the scenario's, else 100)"},
             {"record", "FILE.mcap", "record every stream and the estimates as an MCAP log (replay redoes the run)"},
             {"packets", "", "with --record: also log the HDL-32E's raw UDP packets on /velodyne_packets"},
             {"threads", "N", "worker threads (default: all cores)"}},
@@ -285,6 +290,7 @@ Command compare_command() {
        {{"methods", "LIST", "all, or a comma-separated list of methods (default all, unless --method is given)"},
         {"method", "NAME", "one more method, repeatable: a name or exec:PROGRAM ARGS (docs/external-localizer.md)"},
         {"expect-best", "NAME", "exit 1 unless this method has the lowest lateral, longitudinal and heading RMSE"},
+        {"deadline-ms", "MS", "an exec: localizer's per-scan deadline (default: the scenario's, else 100)"},
         {"seeds", "LIST", "run every seed of a list (1,2,3) or range (1-5); print each method's mean and spread"},
         {"paper", "TABLE", "print the paper's Table II (static) or III (dynamic) beside ours"},
         {"out", "DIR", "output folder (default out/<scenario name>-compare)"},
@@ -295,6 +301,14 @@ Command compare_command() {
        1,
        1},
       run_compare};
+}
+
+void apply_deadline_option(const Args& args, LocalizerParams& params) {
+  if (!args.value("deadline-ms")) return;
+  constexpr double kMaxDeadlineMs = 60000;  // a minute per scan: beyond it, a typo
+  const double ms = args.number("deadline-ms", params.external.deadline_ms);
+  if (!(ms > 0 && ms <= kMaxDeadlineMs)) throw InputError("--deadline-ms must be above 0 and at most 60000");
+  params.external.deadline_ms = ms;
 }
 
 }  // namespace lidarloop

@@ -33,6 +33,9 @@ int run_bench_loop(const Args& args);
 
 // --threads N: 0 means all cores. Returns the effective count.
 int thread_count(const Args& args);
+struct LocalizerParams;
+// --deadline-ms: an exec: localizer's per-scan deadline over the scenario's localizer.external.deadline_ms.
+void apply_deadline_option(const Args& args, LocalizerParams& params);
 // --realism ideal|typical|harsh, if given; InputError for any other word.
 std::optional<Realism> realism_option(const Args& args);
 
