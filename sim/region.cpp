@@ -36,7 +36,7 @@ Paths square(cInt x0, cInt y0, cInt size) {
 }
 
 struct IntPointHash {
-  size_t operator()(const IntPoint& p) const { return std::hash<cInt>()(p.X * 1000003 + p.Y); }
+  size_t operator()(const IntPoint& p) const { return std::hash<uint64_t>()(uint64_t(p.X) * 1000003u + uint64_t(p.Y)); }
 };
 
 struct Mesher {
