@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -174,6 +175,9 @@ LocalizerEstimate ExternalLocalizer::parse_answer(const std::string& line, const
       return e;
     }
     e.health = 0;
+    // The protocol carries no protection bounds: none given (NaN), not "anywhere" (infinity), so the
+    // scorer does not count the program's frames as bounded.
+    e.protection_lateral_m = e.protection_longitudinal_m = std::numeric_limits<double>::quiet_NaN();
     e.pose = {finite_number(answer, "x", where), finite_number(answer, "y", where),
               wrap_angle(finite_number(answer, "yaw", where))};
     if (answer.contains("stamp_ns")) {

@@ -1,6 +1,8 @@
 #include "localizer/localizer_params.hpp"
 
 #include <cctype>
+#include <charconv>
+#include <cstdio>
 #include <stdexcept>
 
 namespace lidarloop {
@@ -73,6 +75,34 @@ void set_method(LocalizerParams& params, const std::string& text) {
   params.external.command.clear();
 }
 
+LatencyParams parse_latency(const std::string& text) {
+  if (text == "one_scan") return {LatencyModel::one_scan, 0};
+  if (text == "measured") return {LatencyModel::measured, 0};
+  constexpr double kMaxLatencyMs = 60000;  // a minute per scan: beyond it, a typo
+  double ms = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), ms);
+  if (ec != std::errc() || end != text.data() + text.size() || !(ms >= 0 && ms <= kMaxLatencyMs))
+    throw std::invalid_argument("latency '" + text +
+                                "': expected one_scan, measured, or milliseconds per scan from 0 to 60000");
+  return {LatencyModel::fixed, ms};
+}
+
+std::string latency_text(const LatencyParams& latency) {
+  switch (latency.model) {
+    case LatencyModel::automatic:
+      return "automatic";
+    case LatencyModel::one_scan:
+      return "one_scan";
+    case LatencyModel::measured:
+      return "measured";
+    case LatencyModel::fixed:
+      break;
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, "%g ms", latency.fixed_ms);
+  return text;
+}
+
 std::string method_label(const LocalizerParams& params) {
   const auto& command = params.external.command;
   if (command.empty()) return method_name(params.method);
@@ -125,6 +155,13 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
     }
   }
   top.integer("seed", p.seed, 0, uint64_t(1) << 62);
+  if (const YAML::Node l = top["latency"]) {
+    try {
+      p.latency = parse_latency(y.string(l, "latency"));
+    } catch (const std::invalid_argument& e) {
+      y.fail(l, e.what());
+    }
+  }
 
   YamlMap(y, top["external"], "external")
       .number("deadline_ms", p.external.deadline_ms, 1.0, 60000.0)

@@ -97,9 +97,28 @@ struct ExternalLocalizerParams {
   double exit_timeout_s = 2;      // to exit after the end of the stream
 };
 
+// When, in closed loop, the controller gets a scan's estimate (loop/localizer_loop.hpp). A real car's
+// localizer starts on a scan once the scan is complete and its answer reaches the controller when it
+// is done, a queue's worth later if it fell behind; the controller carries it to the present by
+// odometry. The localizer itself never reads these.
+enum class LatencyModel {
+  automatic,  // measured for an exec: program, one scan period for a built-in method
+  one_scan,   // each estimate one scan period after its scan: the built-in loop's pipeline
+  measured,   // after the time the localizer took on the scan (wall clock: not repeatable byte for byte)
+  fixed,      // after fixed_ms per scan, as if the localizer always took that long (repeatable)
+};
+struct LatencyParams {
+  LatencyModel model = LatencyModel::automatic;
+  double fixed_ms = 0;
+};
+// "one_scan", "measured" or a number of milliseconds (std::invalid_argument otherwise).
+LatencyParams parse_latency(const std::string& text);
+std::string latency_text(const LatencyParams& latency);
+
 struct LocalizerParams {
   LocalizerMethod method = LocalizerMethod::proposed;
   ExternalLocalizerParams external;
+  LatencyParams latency;
   bool deskew = true;  // beyond the paper: per-point motion compensation from CAN
   // The LiDAR's pose in the vehicle frame (the extrinsic calibration). Not in YAML: it comes with the
   // sensor data (scenario's lidar section, a log's transforms).

@@ -8,9 +8,11 @@
 #include <exception>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <thread>
 #include <variant>
 
+#include "common/input_error.hpp"
 #include "loop/fault_events.hpp"
 #include "loop/localizer_backend.hpp"
 #include "scoring/scorer.hpp"
@@ -34,7 +36,7 @@ class Localizers {
       : scenario_(scenario), result_(result) {
     for (const auto& p : methods) {
       localizers_.push_back(std::make_unique<LocalizerBackend>(map, p, scenario));
-      result_.methods.push_back({localizers_.back()->label(), {}, {}});
+      result_.methods.push_back({localizers_.back()->label(), {}, {}, {}});
     }
   }
 
@@ -71,9 +73,14 @@ class Localizers {
     return primary;
   }
 
-  // After the drive: external programs are told the stream ended and must exit cleanly.
+  // After the drive: external programs are told the stream ended and must exit cleanly. One that
+  // does not fails its method (MethodTrace::failure), which keeps what it answered until then.
   void finish() {
-    for (auto& l : localizers_) l->finish();
+    for (size_t i = 0; i < localizers_.size(); ++i) try {
+        localizers_[i]->finish();
+      } catch (const InputError& e) {
+        result_.methods[i].failure = e.what();
+      }
   }
 
  private:
@@ -128,6 +135,16 @@ class PipelinedSink : public StreamSink {
     if (also_) also_->on_lidar_rotation(r);  // the scan's packets, next to the scan
   }
 
+  // Scan k's estimate (k counted from 0) once the localizers have made it, before it is handed out;
+  // rethrows what the localizers threw. Only for a scan not yet handed out.
+  LocalizerEstimate wait_for(size_t k) {
+    std::unique_lock lock(mutex_);
+    estimate_ready_.wait(lock, [&] { return estimates_.size() > k - handed_out_ || failure_; });
+    if (failure_) std::rethrow_exception(failure_);
+    return estimates_[k - handed_out_];
+  }
+  size_t handed_out() const { return handed_out_; }
+
   // Waits for the last scan's estimate, hands out everything held back and stops the worker once it
   // has processed everything; rethrows what the localizers threw. Call after the run.
   void finish() {
@@ -169,6 +186,7 @@ class PipelinedSink : public StreamSink {
       if (failure_) std::rethrow_exception(failure_);
       e = std::move(estimates_.front());
       estimates_.pop_front();
+      ++handed_out_;
     }
     scan_outstanding_ = false;
     if (on_estimate_) on_estimate_(e);
@@ -206,6 +224,7 @@ class PipelinedSink : public StreamSink {
   StreamSink* also_;
   std::function<void(const LocalizerEstimate&)> on_estimate_;
   bool scan_outstanding_ = false;            // simulation thread only
+  size_t handed_out_ = 0;                    // written by the simulation thread only, under the mutex
   std::vector<std::function<void()>> held_;  // simulation thread only
   std::mutex mutex_;                         // guards the four below
   std::condition_variable wake_worker_, estimate_ready_;
@@ -216,15 +235,13 @@ class PipelinedSink : public StreamSink {
   std::thread worker_;  // last: starts once everything above exists
 };
 
-// The controller's pose in closed loop. The localizer runs beside the simulation, so estimate k is
-// not there while scan k is being processed: the controller steers on the newest estimate handed out
-// (the previous scan's, 0.1-0.2 s old) brought up to the present with CAN odometry (Eq. 19), which is
-// what a real car's controller does with a localizer's output. Which estimate is the newest depends
-// only on the simulation's events (estimate k is handed out at scan k + 1), never on how fast the
-// worker is, so closed-loop runs stay deterministic. Until the first estimate: ground truth.
+// The controller's pose in closed loop: the newest estimate it has been given (EstimateDelivery says
+// when), brought up to the present with CAN odometry (Eq. 19), which is what a real car's controller
+// does with a localizer's output (unless the scenario's controller has dead_reckoning off). Until the
+// first estimate: ground truth.
 class DelayedPose {
  public:
-  explicit DelayedPose(const LocalizerParams& params) : params_(params) {}
+  DelayedPose(const LocalizerParams& params, bool dead_reckoning) : params_(params), dead_reckoning_(dead_reckoning) {}
 
   void on_can(const CanFrame& f) {
     const CanMotion m = can_motion(f, params_.vehicle);
@@ -243,11 +260,14 @@ class DelayedPose {
   }
   Pose2d pose(int64_t t_ns, const Pose2d& truth) const {
     if (!estimate_ || history_.empty()) return truth;
+    if (!dead_reckoning_) return estimate_->pose;
     return estimate_->pose.compose(relative(odometry_at(estimate_->stamp_ns), odometry_at(t_ns)));
   }
 
  private:
-  static constexpr int64_t kKeepWithoutEstimateNs = 1'000'000'000;
+  // Before the first estimate, the odometry of this long is kept: a first estimate older than this
+  // (a localizer so slow it fell seconds behind) is carried from the oldest kept frame.
+  static constexpr int64_t kKeepWithoutEstimateNs = 10'000'000'000;
   struct Stamped {
     int64_t stamp_ns;
     Pose2d pose;
@@ -274,16 +294,88 @@ class DelayedPose {
   }
 
   const LocalizerParams& params_;
+  bool dead_reckoning_;
   std::deque<Odometry> history_;
   std::optional<Stamped> estimate_;
+};
+
+// When each estimate reaches the controller (LatencyParams), in simulated time: the localizer starts
+// on scan k when the scan is complete or when it is done with scan k - 1, whichever is later, takes
+// the scan's latency, and the controller gets the estimate then. So a localizer slower than the scan
+// period falls behind, as a real one that does not drop scans would. The delivery depends only on the
+// simulation's events and the latencies, never on how fast the worker thread is: with a fixed latency
+// (one scan period is the pipelined loop's own: estimate k at scan k + 1) a run stays repeatable.
+class EstimateDelivery {
+ public:
+  EstimateDelivery(const LatencyParams& latency, int64_t scan_period_ns, PipelinedSink& sink, DelayedPose& pose)
+      : latency_(latency), scan_period_ns_(scan_period_ns), sink_(sink), pose_(pose) {}
+
+  void on_scan(int64_t t_ns) { complete_ns_.push_back(t_ns); }
+  void on_handed_out(const LocalizerEstimate& e) { handed_out_.push_back(e); }
+
+  // Gives the controller every estimate due by t_ns; may wait for the localizers to make one.
+  void deliver_due(int64_t t_ns) {
+    while (next_ < complete_ns_.size()) {
+      const int64_t start_ns = std::max(complete_ns_[next_], done_ns_);
+      if (t_ns < start_ns) return;
+      if (!due_ns_) due_ns_ = start_ns + latency_ns();
+      if (t_ns < *due_ns_) return;
+      pose_.on_estimate(estimate(next_));
+      delays_ms_.push_back(1e-6 * double(*due_ns_ - complete_ns_[next_]));
+      done_ns_ = *due_ns_;
+      due_ns_.reset();
+      ++next_;
+      while (first_handed_out_ < std::min(next_, sink_.handed_out())) {
+        handed_out_.pop_front();
+        ++first_handed_out_;
+      }
+    }
+  }
+  // Per delivered estimate: from its scan's completion to the controller, ms.
+  const std::vector<double>& delays_ms() const { return delays_ms_; }
+
+ private:
+  int64_t latency_ns() {
+    switch (latency_.model) {
+      case LatencyModel::one_scan:
+        return scan_period_ns_;
+      case LatencyModel::fixed:
+        return std::llround(latency_.fixed_ms * 1e6);
+      case LatencyModel::measured:
+        return std::llround(estimate(next_).total_ms * 1e6);
+      case LatencyModel::automatic:
+        break;
+    }
+    throw std::logic_error("EstimateDelivery: the latency model was not resolved");
+  }
+  LocalizerEstimate estimate(size_t k) {
+    if (k < first_handed_out_ + handed_out_.size()) return handed_out_[k - first_handed_out_];
+    return sink_.wait_for(k);
+  }
+
+  LatencyParams latency_;
+  int64_t scan_period_ns_;
+  PipelinedSink& sink_;
+  DelayedPose& pose_;
+  std::vector<int64_t> complete_ns_;          // per scan: when the simulation completed it
+  std::deque<LocalizerEstimate> handed_out_;  // from scan first_handed_out_ on
+  size_t first_handed_out_ = 0;
+  size_t next_ = 0;                // the next scan whose estimate the controller has not been given
+  int64_t done_ns_ = INT64_MIN;    // when the localizer finished the previous scan
+  std::optional<int64_t> due_ns_;  // scan next_'s estimate's delivery, once known
+  std::vector<double> delays_ms_;
 };
 
 // What the simulation thread itself takes from the streams before the localizers' sink: the truth for
 // the scorer, the scan count, and the CAN frames the controller's dead reckoning needs.
 class SimulationTap : public StreamSink {
  public:
-  SimulationTap(StreamSink& next, LoopResult& result, DelayedPose* controller_pose)
-      : next_(next), result_(result), controller_pose_(controller_pose) {}
+  SimulationTap(StreamSink& next, LoopResult& result, DelayedPose* controller_pose,
+                std::function<void()> on_scan_complete)
+      : next_(next),
+        result_(result),
+        controller_pose_(controller_pose),
+        on_scan_complete_(std::move(on_scan_complete)) {}
   void on_truth(const TruthSample& t) override {
     result_.truth.push_back(t);
     next_.on_truth(t);
@@ -297,6 +389,7 @@ class SimulationTap : public StreamSink {
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& a) override { next_.on_actors(stamp_ns, a); }
   void on_scan(const PointCloud& cloud, const Eigen::Isometry3d& sensor_pose) override {
     ++result_.scans;
+    if (on_scan_complete_) on_scan_complete_();
     next_.on_scan(cloud, sensor_pose);
   }
   void on_lidar_rotation(const Hdl32eRotation& r) override { next_.on_lidar_rotation(r); }
@@ -309,9 +402,15 @@ class SimulationTap : public StreamSink {
   StreamSink& next_;
   LoopResult& result_;  // only the fields above: the localizers' thread writes the others
   DelayedPose* controller_pose_;
+  std::function<void()> on_scan_complete_;
 };
 
 }  // namespace
+
+LatencyParams controller_latency(const LocalizerParams& params) {
+  if (params.latency.model != LatencyModel::automatic) return params.latency;
+  return {params.external.command.empty() ? LatencyModel::one_scan : LatencyModel::measured, 0};
+}
 
 LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<LocalizerParams>& methods,
                               bool closed_loop, StreamSink* also, const std::function<void(double)>& progress,
@@ -320,20 +419,31 @@ LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<Loc
   if (methods.empty()) return result;
   Localizers localizers(map, methods, sim.scenario(), result);
   std::optional<DelayedPose> controller_pose;
-  if (closed_loop) controller_pose.emplace(methods.front());
+  std::optional<EstimateDelivery> delivery;
+  if (closed_loop) controller_pose.emplace(methods.front(), sim.scenario().ego.controller.dead_reckoning);
   const auto handed_out = [&](const LocalizerEstimate& e) {
-    if (controller_pose) controller_pose->on_estimate(e);
+    if (delivery) delivery->on_handed_out(e);
     if (on_estimate) on_estimate(e);
   };
   const auto t0 = Clock::now();
   {
     PipelinedSink sink(localizers, also, handed_out);
-    SimulationTap tap(sink, result, controller_pose ? &*controller_pose : nullptr);
-    if (controller_pose)
-      sim.set_pose_source([&](int64_t t_ns, const Pose2d& truth) { return controller_pose->pose(t_ns, truth); });
+    std::function<void()> on_scan_complete;
+    if (closed_loop) {
+      delivery.emplace(controller_latency(methods.front()), sim.scenario().lidar.scan_period_ns(), sink,
+                       *controller_pose);
+      on_scan_complete = [&] { delivery->on_scan(sim.now_ns()); };
+      sim.set_pose_source([&](int64_t t_ns, const Pose2d& truth) {
+        delivery->deliver_due(t_ns);
+        return controller_pose->pose(t_ns, truth);
+      });
+    }
+    SimulationTap tap(sink, result, controller_pose ? &*controller_pose : nullptr, on_scan_complete);
     sim.run(tap, progress);
     sim.set_pose_source({});
     sink.finish();
+    if (delivery) result.controller_delays_ms = delivery->delays_ms();
+    delivery.reset();  // it refers to the sink
   }
   localizers.finish();
   result.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();

@@ -2,7 +2,7 @@
 // The simulator and the localizer in one loop: every CAN frame, GPS fix and scan the simulation emits
 // goes, in time order, to one or more localizers (one per method: `compare` feeds them all the same
 // stream), and each scan's estimate is kept with the ground truth for scoring. In closed loop the
-// first method's estimate is what the controller steers on (a scan late: see run_localizer_loop).
+// first method's estimate is what the controller steers on, once its latency has passed.
 #include <functional>
 #include <memory>
 #include <string>
@@ -26,6 +26,9 @@ struct MethodTrace {
   std::string method;
   std::vector<LocalizerEstimate> estimates;
   WorstFrame worst;  // of the frames the scorer rates (not settling or recovering)
+  // An outside program that failed after its last answer (did not exit, exited non-zero): the
+  // estimates are kept, and the run is to be reported failed with this.
+  std::string failure;
 };
 
 struct LoopResult {
@@ -35,12 +38,19 @@ struct LoopResult {
   double wall_s = 0;            // whole loop
   double localizer_wall_s = 0;  // inside the localizers
   size_t scans = 0;
+  // Closed loop: per estimate the controller was given, ms from its scan's completion to the controller.
+  std::vector<double> controller_delays_ms;
 };
+
+// The latency model a closed loop uses for `params` (LatencyParams): `automatic` resolved, to the
+// measured latency for an exec: program and to one scan period for a built-in method.
+LatencyParams controller_latency(const LocalizerParams& params);
 
 // Runs `sim` to its end. `also`: another sink that sees every stream too (a recorder), or null.
 // `progress` is called with the fraction done. The localizers run on a thread beside the simulation.
-// Closed loop: the controller steers on the first method's newest handed-out estimate (the previous
-// scan's) carried forward to the present by CAN odometry, once the localizer is initialised.
+// Closed loop: the controller steers on the first method's newest estimate it has been given (when:
+// the first method's controller_latency) carried forward to the present by CAN odometry, once the
+// localizer is initialised.
 // `on_estimate` sees the first method's every estimate as it is made (a recorder).
 LoopResult run_localizer_loop(Simulation& sim, HdMap& map, const std::vector<LocalizerParams>& methods,
                               bool closed_loop, StreamSink* also = nullptr,

@@ -49,27 +49,34 @@ std::vector<TruthPose> truth_poses(const std::vector<TruthSample>& truth) {
 std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate>& estimates) {
   std::vector<EstimateRecord> out;
   out.reserve(estimates.size());
-  for (const auto& e : estimates)
-    if (!(e.health & kNotInitialized))
-      out.push_back({e.stamp_ns,
-                     {e.pose.x, e.pose.y, ros2::published_yaw(e.pose.yaw)},
-                     e.covariance,
-                     describe_health(e.health),
-                     e.total_ms,
-                     e.lost(),
-                     e.protection_lateral_m,
-                     e.protection_longitudinal_m});
+  for (size_t i = 0; i < estimates.size(); ++i) {
+    const LocalizerEstimate& e = estimates[i];
+    if (e.health & kNotInitialized) continue;
+    out.push_back({e.stamp_ns,
+                   {e.pose.x, e.pose.y, ros2::published_yaw(e.pose.yaw)},
+                   e.covariance,
+                   describe_health(e.health),
+                   e.total_ms,
+                   i == 0,
+                   e.lost(),
+                   e.protection_lateral_m,
+                   e.protection_longitudinal_m});
+  }
   return out;
 }
 
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthPose>& truth, const std::string& method,
                           const std::vector<EstimateRecord>& estimates, const WorstFrame* worst, const HdMap& map,
-                          const std::vector<CurbVisibility>& curb_visibility) {
+                          const std::vector<CurbVisibility>& curb_visibility, const std::string& failure) {
   const std::vector<FaultEvent> events =
       truth.empty() ? std::vector<FaultEvent>{} : fault_events(scenario, truth.front().stamp_ns);
   ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name, events, curb_visibility,
                            scenario.lidar.scan_period_ns());
+  if (!failure.empty()) {
+    scored.metrics.failures.push_back(failure);
+    scored.metrics.pass = false;
+  }
   scored.metrics.realism = realism_name(scenario.realism);
   scored.metrics.realism_overrides = realism_overrides(scenario);
   const MountDraw mount = draw_mount_error(scenario.mount_error, scenario.seed);  // as the simulation drew it
@@ -91,9 +98,9 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthSample>& truth, const std::string& method,
                           const std::vector<LocalizerEstimate>& estimates, const WorstFrame* worst, const HdMap& map,
-                          const std::vector<CurbVisibility>& curb_visibility) {
+                          const std::vector<CurbVisibility>& curb_visibility, const std::string& failure) {
   return score_and_write(dir, scenario_name, scenario, route, truth_poses(truth), method, estimate_records(estimates),
-                         worst, map, curb_visibility);
+                         worst, map, curb_visibility, failure);
 }
 
 }  // namespace lidarloop

@@ -24,16 +24,18 @@ std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate
 // errors.png, trajectory.png, and worst_frame.png when `worst` is given (else none). `realism`,
 // the mount error, the thresholds and the fault events (loop/fault_events.hpp, from the first truth
 // stamp) come from `scenario`. `curb_visibility`: the simulator's
-// per-scan records (empty when not known). `run`, `compare`, `replay` and `score` all end here.
+// per-scan records (empty when not known). `failure`: what failed the method beyond the thresholds (an
+// outside program that did not exit cleanly), or empty. `run`, `compare`, `replay` and `score` all end
+// here.
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthPose>& truth, const std::string& method,
                           const std::vector<EstimateRecord>& estimates, const WorstFrame* worst, const HdMap& map,
-                          const std::vector<CurbVisibility>& curb_visibility);
+                          const std::vector<CurbVisibility>& curb_visibility, const std::string& failure = {});
 
 // The same from the loop's records (estimate_records, truth_poses).
 ScoredRun score_and_write(const std::string& dir, const std::string& scenario_name, const Scenario& scenario,
                           const Path& route, const std::vector<TruthSample>& truth, const std::string& method,
                           const std::vector<LocalizerEstimate>& estimates, const WorstFrame* worst, const HdMap& map,
-                          const std::vector<CurbVisibility>& curb_visibility);
+                          const std::vector<CurbVisibility>& curb_visibility, const std::string& failure = {});
 
 }  // namespace lidarloop

@@ -151,6 +151,7 @@ std::string metrics_json(const Metrics& m) {
       {"latency_p50_ms", finite_or_null(m.latency_p50_ms)},
       {"latency_p99_ms", finite_or_null(m.latency_p99_ms)},
       {"latency_max_ms", finite_or_null(m.latency_max_ms)},
+      {"latency_first_scan_ms", finite_or_null(m.latency_first_scan_ms)},
       {"coverage", finite_or_null(m.coverage)},
       {"largest_gap_s", finite_or_null(m.largest_gap_s)},
       {"max_lane_offset_m", finite_or_null(m.max_lane_offset_m)},
@@ -234,6 +235,12 @@ std::string recovery_text(const EventRecovery& r) {
   return r.event.what + " at " + format("%.2f s", double(r.event.stamp_ns) / double(kNsPerS)) + ": converged after " +
          cell(r.converged_after_s, "%.2f s") + ", lost raised after " + cell(r.lost_raised_after_s, "%.2f s") +
          ", cleared after " + cell(r.lost_cleared_after_s, "%.2f s");
+}
+
+std::string latency_text(const Metrics& m) {
+  return "localizer p50 " + cell(m.latency_p50_ms, "%.1f ms") + ", p99 " + cell(m.latency_p99_ms, "%.1f ms") +
+         ", max " + cell(m.latency_max_ms, "%.1f ms") + "; the first scan, with the start-up, " +
+         cell(m.latency_first_scan_ms, "%.1f ms");
 }
 
 std::string integrity_lines(const Metrics& m, const std::string& label) {

@@ -61,5 +61,7 @@ std::string recovery_text(const EventRecovery& r);
 // The three above as a command's summary lines ("nees       ...", "integrity  ...", one "recovery   ..."
 // per event), each after "label: " when a label is given (a method, in a comparison).
 std::string integrity_lines(const Metrics& m, const std::string& label = "");
+// The localizer's time per scan: p50, p99 and max, and the first scan's (with the start-up) apart.
+std::string latency_text(const Metrics& m);
 
 }  // namespace lidarloop

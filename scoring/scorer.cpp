@@ -364,7 +364,10 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
   std::vector<FrameError> in_range;  // every estimate in the truth's range, settling or not: for recovery
   for (size_t i = 0; i < estimates.size(); ++i) {
     const EstimateRecord& est = estimates[i];
-    if (std::isfinite(est.latency_ms)) latency.push_back(est.latency_ms);
+    if (est.first_scan)
+      m.latency_first_scan_ms = est.latency_ms;
+    else if (std::isfinite(est.latency_ms))
+      latency.push_back(est.latency_ms);
     if (truth.empty() || est.stamp_ns < truth.front().stamp_ns || est.stamp_ns > truth.back().stamp_ns) {
       ++m.unscored_frames;
       continue;

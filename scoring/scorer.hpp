@@ -65,6 +65,9 @@ struct EstimateRecord {
   // Wall time the localizer spent on this frame; NaN when not known (an estimate read from a file),
   // and the latency metrics are then null rather than an invented 0.
   double latency_ms = std::numeric_limits<double>::quiet_NaN();
+  // The run's first scan: its latency includes the localizer's start-up (an outside program starting
+  // and loading its map), so it is reported apart from the others'.
+  bool first_scan = false;
   // The localizer's own word that it is lost (its pose is not to be trusted): such a frame is never
   // counted as misleading. False when not known.
   bool lost = false;
@@ -157,6 +160,8 @@ struct Metrics {
   double max_position_error_m = 0, max_lateral_m = 0, max_longitudinal_m = 0, max_heading_deg = 0;  // absolute
   int64_t worst_frame_stamp_ns = 0;  // the frame with the largest position error (for a bird's-eye plot)
   double latency_p50_ms = 0, latency_p99_ms = 0, latency_max_ms = 0;  // over every known latency; NaN: none
+  double latency_first_scan_ms =
+      std::numeric_limits<double>::quiet_NaN();  // the first scan's, not in the three above; NaN: not known
   // How much of the truth's time span the estimates cover, and the longest stretch they leave
   // uncovered, by the definition of estimate_coverage() below; NaN without a truth span.
   double coverage = std::numeric_limits<double>::quiet_NaN();

@@ -33,6 +33,11 @@ struct ControllerParams {
   double max_lateral_accel = 2.0;  // m/s^2 on curves
   double comfort_decel = 2.0;      // m/s^2 towards stops
   double stop_tolerance = 0.3;     // m: close enough to a stop line
+  // In closed loop, whether the newest estimate is carried to the present with CAN odometry before
+  // the controller steers on it, as production stacks compensate a pose's delay (Autoware's EKF
+  // localizer and Apollo's MSF both do). false: the car steers on the estimate as it came, its latency
+  // uncompensated, as a naive stack would (loop/localizer_loop.cpp).
+  bool dead_reckoning = true;
 };
 
 struct ControllerCommand {

@@ -232,6 +232,7 @@ EgoSpec read_ego(const YamlReader& y, const YAML::Node& n, const VehicleParams& 
       .number("preview_s", e.controller.preview_s, 0.0, 2.0)
       .number("max_lateral_accel", e.controller.max_lateral_accel, 0.5, 8.0)
       .number("comfort_decel", e.controller.comfort_decel, 0.5, 8.0)
+      .boolean("dead_reckoning", e.controller.dead_reckoning)
       .done();
   m.done();
   return e;

@@ -120,14 +120,20 @@ int run_replay(const Args& args) {
     }
   }
   flush_gps();
-  localizer.finish();
+  std::string failure;  // a program that fails after its last answer: its answers are still scored
+  try {
+    localizer.finish();
+  } catch (const InputError& e) {
+    failure = e.what();
+  }
   if (truth.empty()) throw InputError(log + ": no " + std::string(topics::truth_state) + " messages to score against");
 
   const ScoredRun scored = score_and_write(out, name, scenario, resolved.ego_route, truth, method_label(params),
-                                           estimates, nullptr, map, curb_visibility);
+                                           estimates, nullptr, map, curb_visibility, failure);
   std::cout << comparison_markdown({scored.metrics});
   std::printf("\nlog        %s (%zu scans, seed %llu, recorded with %s)\n", log.c_str(), scans,
               (unsigned long long)scenario.seed, recorded_method.empty() ? "no localizer" : recorded_method.c_str());
+  std::printf("latency    %s\n", latency_text(scored.metrics).c_str());
   std::printf("curbs      %s\n", curb_occlusion_text(scored.metrics).c_str());
   if (method == recorded_method) compare_statuses(log, recorded_statuses, estimates);
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
@@ -135,6 +141,7 @@ int run_replay(const Args& args) {
       "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
       "trajectory.png)\n",
       scored.metrics.pass ? "PASS" : "FAIL", out.c_str());
+  if (!failure.empty()) throw InputError(failure + " (the replay's results are in " + out + "/, failed)");
   return scored.metrics.pass ? 0 : 1;
 }
 

@@ -69,6 +69,17 @@ struct Progress {
   }
 };
 
+// In closed loop: when the estimates reached the controller, after their scans.
+std::string controller_latency_text(const LatencyParams& model, const std::vector<double>& delays_ms) {
+  if (delays_ms.empty()) return "no estimate reached the controller";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "the controller got each estimate %.1f ms (p50), at most %.1f ms, after its scan (%s)",
+                percentile_nearest_rank(delays_ms, 50), *std::max_element(delays_ms.begin(), delays_ms.end()),
+                latency_text(model).c_str());
+  return text;
+}
+
 int run_run(const Args& args) {
   const int threads = thread_count(args);
   const auto limit = limit_threads(threads);
@@ -79,6 +90,14 @@ int run_run(const Args& args) {
   }
   LocalizerParams params = localizer_params_for(s.scenario, args.value("method"));
   apply_deadline_option(args, params);
+  if (const auto latency = args.value("latency")) {
+    try {
+      params.latency = parse_latency(*latency);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(std::string("--latency: ") + e.what());
+    }
+  }
+  const bool external = !params.external.command.empty();
   const std::string name = std::filesystem::path(s.scenario.file).stem().string();
   const std::string out = args.text("out", "out/" + name);
   // Every output is opened before the map and the run: one that cannot be written fails at once.
@@ -98,30 +117,36 @@ int run_run(const Args& args) {
 
   const MethodTrace& trace = r.methods.front();
   const ScoredRun scored = score_and_write(out, name, s.scenario, sim.resolved().ego_route, r.truth, trace.method,
-                                           trace.estimates, &trace.worst, map, r.curb_visibility);
-  const double lane_offset = scored.metrics.max_lane_offset_m;
-  std::cout << comparison_markdown({scored.metrics});
+                                           trace.estimates, &trace.worst, map, r.curb_visibility, trace.failure);
+  const Metrics& m = scored.metrics;
+  std::cout << comparison_markdown({m});
   std::printf("\nscenario   %s (seed %llu, %s loop), %.1f s simulated in %.1f s wall (%.1fx real time, %d thread(s))\n",
               s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.closed_loop ? "closed" : "open",
               s.scenario.duration_s, r.wall_s, s.scenario.duration_s / r.wall_s, threads);
   print_realism(s.scenario);
   std::printf("localizer  %zu scans, %.2f ms per scan on average, %.1f%% of the loop's time\n", r.scans,
               1e3 * r.localizer_wall_s / double(std::max<size_t>(r.scans, 1)), 100 * r.localizer_wall_s / r.wall_s);
-  std::printf("lane       the car stayed within %.2f m of its lane's centre\n", lane_offset);
-  std::printf("coverage   %.1f%% of the drive had an estimate (largest gap %.2f s)\n", 100 * scored.metrics.coverage,
-              scored.metrics.largest_gap_s);
-  size_t with_obstacles = 0;
-  for (const auto& e : trace.estimates) with_obstacles += e.obstacle_points >= kObstacleScanPoints;
-  std::printf("obstacles  in the corridor in %zu of %zu scans (%.0f%%)\n", with_obstacles, trace.estimates.size(),
-              100.0 * double(with_obstacles) / double(std::max<size_t>(trace.estimates.size(), 1)));
-  std::printf("curbs      %s\n", curb_occlusion_text(scored.metrics).c_str());
-  std::cout << integrity_lines(scored.metrics);
-  for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
+  std::printf("latency    %s\n", latency_text(m).c_str());
+  if (s.scenario.closed_loop)
+    std::printf("           %s\n", controller_latency_text(controller_latency(params), r.controller_delays_ms).c_str());
+  std::printf("lane       the car stayed within %.2f m of its lane's centre\n", m.max_lane_offset_m);
+  std::printf("coverage   %.1f%% of the drive had an estimate (largest gap %.2f s)\n", 100 * m.coverage,
+              m.largest_gap_s);
+  if (!external) {  // an outside program does not say which points it took for obstacles
+    size_t with_obstacles = 0;
+    for (const auto& e : trace.estimates) with_obstacles += e.obstacle_points >= kObstacleScanPoints;
+    std::printf("obstacles  in the corridor in %zu of %zu scans (%.0f%%)\n", with_obstacles, trace.estimates.size(),
+                100.0 * double(with_obstacles) / double(std::max<size_t>(trace.estimates.size(), 1)));
+  }
+  std::printf("curbs      %s\n", curb_occlusion_text(m).c_str());
+  std::cout << integrity_lines(m);
+  for (const auto& f : m.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
       "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
       "trajectory.png, worst_frame.png)\n",
-      scored.metrics.pass ? "PASS" : "FAIL", out.c_str());
-  return scored.metrics.pass ? 0 : 1;
+      m.pass ? "PASS" : "FAIL", out.c_str());
+  if (!trace.failure.empty()) throw InputError(trace.failure + " (the run's results are in " + out + "/, failed)");
+  return m.pass ? 0 : 1;
 }
 
 std::vector<std::string> parse_methods(const std::string& list) {
@@ -181,11 +206,15 @@ std::vector<Metrics> compare_once(const LoadedScenario& s, const std::vector<std
   std::vector<Metrics> metrics;
   for (const auto& trace : r.methods)
     metrics.push_back(score_and_write(out + "/" + trace.method, name, s.scenario, sim.resolved().ego_route, r.truth,
-                                      trace.method, trace.estimates, &trace.worst, map, r.curb_visibility)
+                                      trace.method, trace.estimates, &trace.worst, map, r.curb_visibility,
+                                      trace.failure)
                           .metrics);
   write_junit(out + "/junit.xml", metrics);
   write_comparison_csv(out + "/comparison.csv", metrics);
   write_text_file(out + "/comparison.md", comparison_markdown(metrics));
+  for (const auto& trace : r.methods)
+    if (!trace.failure.empty())
+      throw InputError(trace.failure + " (the comparison's results are in " + out + "/, " + trace.method + " failed)");
   return metrics;
 }
 
@@ -272,6 +301,9 @@ Command run_command() {
             {"realism", "PROFILE", "ideal, typical or harsh: replaces the scenario's realism profile"},
             {"duration", "S", "override the scenario's duration, seconds"},
             {"deadline-ms", "MS", "an exec: localizer's per-scan deadline (default: the scenario's, else 100)"},
+            {"latency", "MODEL",
+             "closed loop: when an estimate reaches the controller: one_scan, measured or MS per scan\n"
+             "(default: the scenario's localizer.latency; measured for exec:, one_scan for built-in methods)"},
             {"record", "FILE.mcap", "record every stream and the estimates as an MCAP log (replay redoes the run)"},
             {"packets", "", "with --record: also log the HDL-32E's raw UDP packets on /velodyne_packets"},
             {"threads", "N", "worker threads (default: all cores)"}},

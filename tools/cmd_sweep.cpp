@@ -101,7 +101,9 @@ void prepare(const SweepSpec& spec, const std::vector<const SweepRun*>& runs) {
   }
 }
 
-PoolTask task_for(const SweepSpec& spec, const SweepRun& run, const std::string& run_dir, int threads) {
+// `deadline_ms`: --deadline-ms as given to the sweep, for every run, or empty.
+PoolTask task_for(const SweepSpec& spec, const SweepRun& run, const std::string& run_dir, int threads,
+                  const std::optional<std::string>& deadline_ms) {
   PoolTask t;
   t.argv = {self_executable()};
   const std::string scenario = run_dir + "/scenario.yaml";
@@ -113,6 +115,7 @@ PoolTask task_for(const SweepSpec& spec, const SweepRun& run, const std::string&
     for (const auto& m : run.methods) t.argv.insert(t.argv.end(), {"--method", m});  // exec: lines may hold commas
   }
   t.argv.insert(t.argv.end(), {"--threads", std::to_string(threads)});
+  if (deadline_ms) t.argv.insert(t.argv.end(), {"--deadline-ms", *deadline_ms});
   t.log_path = run_dir + "/log.txt";
   t.timeout_s = spec.timeout_s;
   return t;
@@ -222,6 +225,8 @@ int run_sweep(const Args& args) {
   const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
   const int jobs = int(args.integer("jobs", cores, 1, 1024));
   const int threads = std::max(1, cores / jobs);
+  LocalizerParams checked;  // --deadline-ms is checked here, once, rather than failing every run
+  apply_deadline_option(args, checked);
 
   fs::create_directories(out + "/runs");
   const SweepPlan plan = make_sweep_plan(spec, runs);
@@ -258,7 +263,7 @@ int run_sweep(const Args& args) {
     fs::remove_all(dir);  // whatever an unfinished attempt left
     fs::create_directories(dir);
     write_text_file(dir + "/scenario.yaml", r->scenario_text);
-    tasks.push_back(task_for(spec, *r, dir, threads));
+    tasks.push_back(task_for(spec, *r, dir, threads, args.value("deadline-ms")));
   }
   const bool terminal = isatty(STDOUT_FILENO) != 0;
   size_t unfinished = 0;
@@ -322,6 +327,7 @@ Command sweep_command() {
         {"out", "DIR", "output folder (default out/sweeps/<sweep name>); merge and render: where the result goes"},
         {"shard", "I/N", "run only shard I of N (0 <= I < N): the runs whose index is I modulo N"},
         {"dry-run", "", "check every run's scenario and build the maps, list the runs, run none"},
+        {"deadline-ms", "MS", "every run's exec: localizer's per-scan deadline (default: each scenario's, else 100)"},
         {"shards", "N", "the number of shards when the index comes from $JOB_COMPLETION_INDEX or $SLURM_ARRAY_TASK_ID"},
         {"engine", "NAME", "render: kubernetes or slurm"},
         {"image", "IMAGE", "render: the container image with lidarloop built (Kubernetes)"},

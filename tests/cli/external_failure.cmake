@@ -1,6 +1,7 @@
 # A localizer program that breaks the protocol (tests/external/misbehaving_localizer.cpp): the run must
 # end with exit 2 and a message naming the scan (EXPECT_OUTPUT), within seconds, and the log recorded
-# up to then must be a complete, readable MCAP file.
+# up to then must be a complete, readable MCAP file. With EXPECT_RESULTS in the environment (a program
+# that fails only after its last answer), the run's results must be written and marked failed.
 # -DLIDARLOOP=... -DSCENARIO=... -DMETHOD=exec:... -DEXPECT_OUTPUT=... -DWORKDIR=...
 file(REMOVE_RECURSE ${WORKDIR})
 file(MAKE_DIRECTORY ${WORKDIR})
@@ -15,5 +16,17 @@ execute_process(COMMAND ${LIDARLOOP} info ${WORKDIR}/run.mcap RESULT_VARIABLE co
                 ERROR_VARIABLE info_err)
 if(NOT code EQUAL 0)
   message(FATAL_ERROR "the log of the failed run is not readable (info exited ${code}):\n${info}\n${info_err}")
+endif()
+if(DEFINED ENV{EXPECT_RESULTS})
+  if(NOT EXISTS ${WORKDIR}/out/metrics.json)
+    message(FATAL_ERROR "the program failed after its last answer, and the run's results were not written")
+  endif()
+  file(READ ${WORKDIR}/out/metrics.json metrics)
+  string(JSON pass GET "${metrics}" pass)
+  string(JSON failures GET "${metrics}" failures)
+  string(FIND "${failures}" "${EXPECT_OUTPUT}" named)
+  if(pass OR named EQUAL -1)
+    message(FATAL_ERROR "metrics.json must say the run failed, with '${EXPECT_OUTPUT}': pass ${pass}, failures ${failures}")
+  endif()
 endif()
 message(STATUS "${err}")

@@ -3,7 +3,8 @@
 //   misbehaving_localizer MODE SCAN
 // MODE: sleep (sleeps 30 s instead of answering), exit (exits with status 3), garbage (prints a line
 // that is not JSON), wrong-scan (answers for the wrong scan), stop-reading (closes stdin and sleeps),
-// linger (answers every scan, then ignores the end of its input and sleeps 30 s).
+// linger (answers every scan, then ignores the end of its input and sleeps 30 s); slow (takes SCAN
+// milliseconds over every answer, for the measured latency in closed loop).
 #include <unistd.h>
 #include <cstdio>
 #include <cstdlib>
@@ -14,7 +15,7 @@
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    std::fprintf(stderr, "usage: misbehaving_localizer sleep|exit|garbage|wrong-scan|stop-reading|linger SCAN\n");
+    std::fprintf(stderr, "usage: misbehaving_localizer sleep|exit|garbage|wrong-scan|stop-reading|linger|slow SCAN\n");
     return 2;
   }
   const std::string mode = argv[1];
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   int scan = 0;
   while (reader.next(m)) {
     if (m.channel->topic != lidarloop::log_topics::scan) continue;
+    if (mode == "slow") usleep(useconds_t(at) * 1000);
     if (scan == at) {
       if (mode == "sleep") sleep(30);
       if (mode == "exit") return 3;

@@ -57,5 +57,30 @@ TEST(MethodSpec, ScenarioYamlSetsTheProgramAndItsDeadlines) {
   }
 }
 
+TEST(MethodSpec, LatencyIsOneScanMeasuredOrMilliseconds) {
+  EXPECT_EQ(parse_latency("one_scan").model, LatencyModel::one_scan);
+  EXPECT_EQ(parse_latency("measured").model, LatencyModel::measured);
+  const LatencyParams fixed = parse_latency("80");
+  EXPECT_EQ(fixed.model, LatencyModel::fixed);
+  EXPECT_EQ(fixed.fixed_ms, 80);
+  EXPECT_EQ(latency_text(fixed), "80 ms");
+  for (const char* bad : {"", "-1", "fast", "80ms", "60001", "nan"})
+    EXPECT_THROW(parse_latency(bad), std::invalid_argument) << bad;
+
+  const YamlReader y = YamlReader::from_string("localizer: {latency: 12.5}\n", "s.yaml");
+  LocalizerParams p;
+  EXPECT_EQ(p.latency.model, LatencyModel::automatic);
+  read_localizer_params(y, y.root()["localizer"], p);
+  EXPECT_EQ(p.latency.model, LatencyModel::fixed);
+  EXPECT_EQ(p.latency.fixed_ms, 12.5);
+  const YamlReader bad = YamlReader::from_string("localizer: {latency: soon}\n", "bad.yaml");
+  try {
+    read_localizer_params(bad, bad.root()["localizer"], p);
+    FAIL() << "a bad latency was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml:1:22: latency 'soon'"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace lidarloop
