@@ -264,6 +264,7 @@ class CanGpsFilter:
         self.steering_ratio = meta("vehicle_steering_ratio")
         self.antenna = (meta("gps_antenna_x_m"), meta("gps_antenna_y_m"))
         self.ready, self.t, self.speed, self.steer = False, 0, 0.0, 0.0
+        self.bias_var = 0.0  # the bias's stationary variance per axis, from the first fix
         self.s = [0.0] * 5
         self.P = [[0.0] * 5 for _ in range(5)]
 
