@@ -74,7 +74,7 @@ ExternalLocalizer::ExternalLocalizer(const LocalizerParams& params, const std::m
       child_(params.external.command),
       recorder_(
           label_ + " stdin", [this](std::span<const uint8_t> bytes) { child_.send(bytes); }, params.lidar_mount,
-          stream_options(), kExternalMetadata, metadata) {
+          params.gps_antenna, stream_options(), kExternalMetadata, metadata) {
   recorder_.flush();
 }
 

@@ -38,7 +38,7 @@ Hdl32eRotation seed_rotation(int64_t start_ns) {
 }
 
 void record_log(const std::string& path, McapWriterOptions options) {
-  McapRecorder log(path, Eigen::Isometry3d(Eigen::Translation3d(1.2, 0, 1.9)), options);
+  McapRecorder log(path, Eigen::Isometry3d(Eigen::Translation3d(1.2, 0, 1.9)), Eigen::Vector3d(0.9, 0, 1.5), options);
   log.add_attachment("scenario.yaml", "application/yaml", std::string_view("world: campus\nduration_s: 0.3\n"));
   log.add_metadata("lidarloop.run", {{"seed", "1"}, {"method", "proposed"}});
   for (int i = 0; i < kScans; ++i) {

@@ -23,8 +23,9 @@
 //                                                           packets, logs/hdl32e_packets.hpp)
 //
 // Frames: map is the local transverse Mercator frame (x east, y north, z up); base_link is the
-// vehicle frame (x forward, y left, z up, origin at the rear axle centre on the ground); the GPS
-// antenna model sits at the base_link origin. /truth/body is the pose, in base_link, of the body
+// vehicle frame (x forward, y left, z up, origin at the rear axle centre on the ground); gps is the
+// antenna, whose position a fix is: base_link moved by the configured lever arm (GpsConfig::antenna_xyz,
+// 0.9 m ahead and 1.5 m up by default). /truth/body is the pose, in base_link, of the body
 // frame: the frame that coincides with base_link when the body rests on flat ground, and that pitches
 // and rolls about the centre of mass and heaves with it (identity for a rigid body). The LiDAR is
 // mounted on the body: its true pose is base_link * body * mount, with the mount from /tf_static.

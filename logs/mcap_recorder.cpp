@@ -24,24 +24,28 @@ std::string qos_profile(bool latched) {
 
 }  // namespace
 
-McapRecorder::McapRecorder(const std::string& path, const Eigen::Isometry3d& lidar_mount, McapWriterOptions options)
+McapRecorder::McapRecorder(const std::string& path, const Eigen::Isometry3d& lidar_mount,
+                           const Eigen::Vector3d& gps_antenna, McapWriterOptions options)
     : writer_(path, std::move(options)) {
-  write_transforms(lidar_mount);
+  write_transforms(lidar_mount, gps_antenna);
 }
 
 McapRecorder::McapRecorder(const std::string& name, McapOutput::ByteSink sink, const Eigen::Isometry3d& lidar_mount,
-                           McapWriterOptions options, const std::string& metadata_name,
-                           const std::map<std::string, std::string>& metadata)
+                           const Eigen::Vector3d& gps_antenna, McapWriterOptions options,
+                           const std::string& metadata_name, const std::map<std::string, std::string>& metadata)
     : writer_(name, std::move(sink), std::move(options)) {
   writer_.add_metadata(metadata_name, metadata);
-  write_transforms(lidar_mount);
+  write_transforms(lidar_mount, gps_antenna);
 }
 
-void McapRecorder::write_transforms(const Eigen::Isometry3d& lidar_mount) {
+void McapRecorder::write_transforms(const Eigen::Isometry3d& lidar_mount, const Eigen::Vector3d& gps_antenna) {
   static constexpr ChannelSpec tf_static{t::tf_static, "tf2_msgs/msg/TFMessage", true};
+  // The antenna is a point: its frame is base_link's, moved to it (a fix has no orientation).
+  Eigen::Isometry3d antenna = Eigen::Isometry3d::Identity();
+  antenna.translation() = gps_antenna;
   write(tf_static, 0,
         ros2::encode_tf({ros2::make_transform(0, t::vehicle_frame, t::lidar_frame, lidar_mount),
-                         ros2::make_transform(0, t::vehicle_frame, t::gps_frame, Eigen::Isometry3d::Identity())}));
+                         ros2::make_transform(0, t::vehicle_frame, t::gps_frame, antenna)}));
 }
 
 uint16_t McapRecorder::channel(const ChannelSpec& spec) {

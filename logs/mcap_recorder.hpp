@@ -26,12 +26,16 @@ namespace lidarloop {
 
 class McapRecorder {
  public:
-  // `lidar_mount`: the LiDAR's pose in the vehicle frame, published once on /tf_static.
-  McapRecorder(const std::string& path, const Eigen::Isometry3d& lidar_mount, McapWriterOptions options = {});
+  // `lidar_mount`: the LiDAR's pose in the vehicle frame; `gps_antenna`: the GPS antenna's position in
+  // the vehicle frame (the lever arm from the rear axle; a fix is the antenna's position). Both are published
+  // once on /tf_static (base_link -> lidar, base_link -> gps), so that a ROS user's tf and the fixes on
+  // the gps frame agree. Give the configuration the localizer is given (the nominal extrinsics).
+  McapRecorder(const std::string& path, const Eigen::Isometry3d& lidar_mount, const Eigen::Vector3d& gps_antenna,
+               McapWriterOptions options = {});
   // The same messages into `sink` (a live stream to another program; see McapWriter), with a Metadata
   // record `metadata_name` first, so the reader has it before any message.
   McapRecorder(const std::string& name, McapOutput::ByteSink sink, const Eigen::Isometry3d& lidar_mount,
-               McapWriterOptions options, const std::string& metadata_name,
+               const Eigen::Vector3d& gps_antenna, McapWriterOptions options, const std::string& metadata_name,
                const std::map<std::string, std::string>& metadata);
 
   void write_truth(const TruthSample& truth);
@@ -70,7 +74,7 @@ class McapRecorder {
     const char* type;
     bool latched = false;  // /tf_static: transient-local durability, as ROS 2 publishes it
   };
-  void write_transforms(const Eigen::Isometry3d& lidar_mount);
+  void write_transforms(const Eigen::Isometry3d& lidar_mount, const Eigen::Vector3d& gps_antenna);
   void write(const ChannelSpec& spec, int64_t stamp_ns, const std::vector<uint8_t>& data);
   uint16_t channel(const ChannelSpec& spec);
 

@@ -72,7 +72,8 @@ std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>&
   if (packets && !path) throw InputError("--packets: needs --record FILE.mcap");
   if (!path) return nullptr;
   if (path->empty()) throw InputError("--record: needs a file name");
-  auto recorder = std::make_unique<RecordingSink>(*path, scenario.lidar.mount());
+  // The nominal extrinsics, as localizer_params_for gives the localizer (and an exec: program's metadata).
+  auto recorder = std::make_unique<RecordingSink>(*path, scenario.lidar.mount(), scenario.gps.antenna_xyz);
   recorder->record_packets(packets);
   McapRecorder& log = recorder->log();
   log.add_attachment(kScenarioAttachment, "application/yaml", scenario.text);

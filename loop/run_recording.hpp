@@ -68,7 +68,8 @@ class TeeSink : public StreamSink {
 // The simulator's streams into an MCAP log (logs/ knows messages, not the simulator).
 class RecordingSink : public StreamSink {
  public:
-  RecordingSink(const std::string& path, const Eigen::Isometry3d& lidar_mount) : log_(path, lidar_mount) {}
+  RecordingSink(const std::string& path, const Eigen::Isometry3d& lidar_mount, const Eigen::Vector3d& gps_antenna)
+      : log_(path, lidar_mount, gps_antenna) {}
   void on_truth(const TruthSample& t) override { log_.write_truth(t); }
   void on_can(const CanFrame& f) override { log_.write_can(f); }
   void on_gps(const GpsFix& f) override { log_.write_gps(f); }

@@ -1,7 +1,9 @@
 # The Node.js example localizer (examples/external/node/localizer.mjs) in closed loop: it must pass the
 # scenario's thresholds, and the estimates it wrote with --record (nav_msgs/msg/Odometry in an MCAP file
 # written by @mcap/core) must score, with `lidarloop score` against the run's log, as the live run did.
+# Its covariance must be honest (nees.cmake).
 # -DLIDARLOOP=... -DSCENARIO=... -DMETHOD=exec:... -DWORKDIR=...
+include(${CMAKE_CURRENT_LIST_DIR}/nees.cmake)
 file(REMOVE_RECURSE ${WORKDIR})
 file(MAKE_DIRECTORY ${WORKDIR})
 execute_process(COMMAND ${LIDARLOOP} run ${SCENARIO} --method ${METHOD} --record ${WORKDIR}/run.mcap --out ${WORKDIR}/live
@@ -10,6 +12,7 @@ if(NOT code EQUAL 0)
   message(FATAL_ERROR "the Node.js localizer's run exited ${code}\n${out}\n${err}")
 endif()
 message(STATUS "${out}")
+nees_one_run(${WORKDIR}/live/metrics.json)
 execute_process(COMMAND ${LIDARLOOP} score ${WORKDIR}/run.mcap --estimate ${WORKDIR}/estimates.mcap
                         --topic /localizer/odometry --out ${WORKDIR}/score
                 RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 120)

@@ -21,6 +21,9 @@ struct SyntheticEstimate {
 
 struct SyntheticRun {
   Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
+  // The GPS antenna's lever arm: sim/gps_model.hpp's default (0.9 m ahead of the rear axle, 1.5 m up),
+  // off every axis but y, so a tf that dropped, swapped or zeroed a component shows.
+  Eigen::Vector3d gps_antenna{0.9, 0.0, 1.5};
   std::vector<TruthSample> truth;
   std::vector<CanFrame> can;
   std::vector<GpsFix> gps, rtk;
@@ -112,7 +115,7 @@ inline SyntheticRun make_synthetic_run(double seconds, int points, uint64_t seed
 // Records `run` in simulator order; the scenario goes in as an attachment, seed and version as metadata.
 inline McapWriterStats record_synthetic_run(const SyntheticRun& run, const std::string& path,
                                             McapWriterOptions options = {}) {
-  McapRecorder rec(path, run.mount, std::move(options));
+  McapRecorder rec(path, run.mount, run.gps_antenna, std::move(options));
   rec.add_attachment("scenario.yaml", "application/yaml", run.scenario_yaml);
   rec.add_metadata("run", {{"seed", "7"}, {"version", "test"}, {"map_hash", "0123abcd"}});
   size_t gps = 0, scan = 0;

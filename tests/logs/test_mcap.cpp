@@ -408,6 +408,11 @@ TEST_F(McapLog, EveryStreamRoundTripsExactly) {
   EXPECT_EQ(tf_static[0].child, "lidar");
   EXPECT_EQ(tf_static[0].translation, run.mount.translation());
   EXPECT_TRUE(tf_static[0].rotation.toRotationMatrix().isApprox(run.mount.linear(), 1e-15));
+  // The antenna where the fixes are taken: the lever arm the recorder was given, unrotated.
+  EXPECT_EQ(tf_static[1].parent, "base_link");
+  EXPECT_EQ(tf_static[1].child, "gps");
+  EXPECT_EQ(tf_static[1].translation, run.gps_antenna);
+  EXPECT_TRUE(tf_static[1].rotation.isApprox(Eigen::Quaterniond::Identity(), 1e-15));
   ASSERT_EQ(actors.size(), run.actors.size());
   EXPECT_EQ(actors[1][0].name, "bus_1");
   EXPECT_EQ(actors[1][0].type, "bus");

@@ -12,6 +12,7 @@
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/mcap_recorder.hpp"
+#include "logs/ros2_messages.hpp"
 
 namespace lidarloop {
 namespace {
@@ -63,8 +64,11 @@ struct Pipe {
 
 TEST(McapStream, EachMessageIsReadableAsSoonAsItIsWritten) {
   Bytes sent;
+  // sim/gps_model.hpp's default lever arm, which an exec: program's metadata also gives.
+  const Eigen::Vector3d antenna(0.9, 0.0, 1.5);
   McapRecorder recorder("test stream", [&](std::span<const uint8_t> b) { sent.insert(sent.end(), b.begin(), b.end()); },
-                        Eigen::Isometry3d::Identity(), stream_options(), "lidarloop.external", {{"answer", "42"}});
+                        Eigen::Isometry3d::Identity(), antenna, stream_options(), "lidarloop.external",
+                        {{"answer", "42"}});
   recorder.flush();
   Pipe pipe;
   pipe.write(sent);
@@ -74,6 +78,10 @@ TEST(McapStream, EachMessageIsReadableAsSoonAsItIsWritten) {
   // Metadata first, then /tf_static: all there before anything else is written.
   ASSERT_TRUE(reader.next(m));
   EXPECT_EQ(m.channel->topic, log_topics::tf_static);
+  const std::vector<ros2::Transform> mounts = ros2::decode_tf(m.data, "tf_static");
+  ASSERT_EQ(mounts.size(), 2u);
+  EXPECT_EQ(mounts[1].child, log_topics::gps_frame);
+  EXPECT_EQ(mounts[1].translation, antenna);  // the fixes' lever arm, not the identity
   ASSERT_EQ(reader.metadata().size(), 1u);
   EXPECT_EQ(reader.metadata()[0].metadata.at("answer"), "42");
   // Lockstep: one message written and flushed can be read while the writer waits. A reader that
@@ -96,7 +104,7 @@ TEST(McapStream, EachMessageIsReadableAsSoonAsItIsWritten) {
 TEST(McapStream, AnUnchunkedFileIsAValidLog) {
   const std::string path = testing::TempDir() + "/unchunked_" + std::to_string(getpid()) + ".mcap";
   {
-    McapRecorder recorder(path, Eigen::Isometry3d::Identity(), stream_options());
+    McapRecorder recorder(path, Eigen::Isometry3d::Identity(), Eigen::Vector3d::Zero(), stream_options());
     for (int i = 0; i < 5; ++i) recorder.write_can(can_frame(1000 * i));
     recorder.close();
   }
@@ -114,7 +122,8 @@ TEST(McapStream, AnUnchunkedFileIsAValidLog) {
 TEST(McapStream, AStreamCutInsideARecordIsAnInputError) {
   Bytes sent;
   McapRecorder recorder("test stream", [&](std::span<const uint8_t> b) { sent.insert(sent.end(), b.begin(), b.end()); },
-                        Eigen::Isometry3d::Identity(), stream_options(), "lidarloop.external", {});
+                        Eigen::Isometry3d::Identity(), Eigen::Vector3d::Zero(), stream_options(), "lidarloop.external",
+                        {});
   recorder.write_can(can_frame(1000));
   recorder.flush();
   Pipe pipe;

@@ -118,7 +118,7 @@ TEST(EstimateFile, ALidarloopLogsEstimatesCarryTheirStatus) {
 
   const std::string path = temp("lidarloop_log.mcap");
   {
-    McapRecorder log(path, Eigen::Isometry3d::Identity());
+    McapRecorder log(path, Eigen::Isometry3d::Identity(), Eigen::Vector3d::Zero());
     for (const LocalizerEstimate& e : {waiting, ok, degraded, lost}) record_estimate(log, e);
   }
   const EstimateFile file = read_estimate_file(path, log_topics::estimate);

@@ -51,64 +51,96 @@ function localFrame(lat0Deg, lon0Deg) {
   };
 }
 
-// ---- The filter: EKF over the rear axle's (x, y, yaw), kinematic bicycle on CAN, GPS position.
-const noise = { positionPerS: 0.05, yawPerS: 1e-4, minGpsSigma: 0.5 }; // as the C++ example, same reasons
+// ---- The filter: EKF over the rear axle's (x, y, yaw) and the receiver's position bias (bx, by),
+// kinematic bicycle on CAN, GPS position = pose + R(yaw) antenna + bias + white noise. The noise figures
+// and their sources are the C++ example's, under the same names.
+const noise = {
+  gpsWhiteSigma: 0.4, // m: the fix-to-fix scatter; the rest of the reported variance is the bias
+  gpsBiasTau: 120, // s: the bias's correlation time (minutes: nearly constant over a drive)
+  odometryScaleSigma: 0.01, // of the distance driven
+  sideSlipSigma: 0.01, // rad
+  yawRateSigma: 0.01, // rad/s
+};
+const [X, Y, YAW, BX, BY] = [0, 1, 2, 3, 4];
 const wrap = (a) => Math.atan2(Math.sin(a), Math.cos(a));
-const filter = { ready: false, t: 0n, x: 0, y: 0, yaw: 0, P: [1, 0, 0, 0, 1, 0, 0, 0, 1], speed: 0, steer: 0 };
+const zeros = (r, c) => Array.from({ length: r }, () => new Array(c).fill(0));
+const eye = (n) => zeros(n, n).map((row, i) => row.map((_, j) => (i === j ? 1 : 0)));
+const matmul = (A, B) => A.map((row) => B[0].map((_, j) => row.reduce((sum, a, k) => sum + a * B[k][j], 0)));
+const transpose = (A) => A[0].map((_, j) => A.map((row) => row[j]));
+const filter = { ready: false, t: 0n, s: [0, 0, 0, 0, 0], P: eye(5), biasVar: 0, speed: 0, steer: 0 };
 let vehicle, toLocal;
-
-function mul3(A, B) {
-  const C = new Array(9).fill(0);
-  for (let i = 0; i < 3; i++) for (let j = 0; j < 3; j++) for (let k = 0; k < 3; k++) C[3 * i + j] += A[3 * i + k] * B[3 * k + j];
-  return C;
-}
-const transpose3 = (A) => [A[0], A[3], A[6], A[1], A[4], A[7], A[2], A[5], A[8]];
 
 function predictTo(t) {
   if (!filter.ready || t <= filter.t) return;
   const dt = Number(t - filter.t) * 1e-9;
-  const yawRate = (filter.speed * Math.tan(filter.steer)) / vehicle.wheelbase;
-  const mid = filter.yaw + 0.5 * yawRate * dt;
-  filter.x += filter.speed * dt * Math.cos(mid);
-  filter.y += filter.speed * dt * Math.sin(mid);
-  filter.yaw = wrap(filter.yaw + yawRate * dt);
-  const F = [1, 0, -filter.speed * dt * Math.sin(mid), 0, 1, filter.speed * dt * Math.cos(mid), 0, 0, 1];
-  filter.P = mul3(mul3(F, filter.P), transpose3(F));
-  filter.P[0] += noise.positionPerS * dt;
-  filter.P[4] += noise.positionPerS * dt;
-  filter.P[8] += noise.yawPerS * dt;
+  const { s, speed: v } = filter;
+  const yawRate = (v * Math.tan(filter.steer)) / vehicle.wheelbase;
+  const mid = s[YAW] + 0.5 * yawRate * dt;
+  const c = Math.cos(mid), n = Math.sin(mid);
+  const phi = Math.exp(-dt / noise.gpsBiasTau);
+  s[X] += v * dt * c;
+  s[Y] += v * dt * n;
+  s[YAW] = wrap(s[YAW] + yawRate * dt);
+  s[BX] *= phi;
+  s[BY] *= phi;
+  const F = eye(5);
+  F[X][YAW] = -v * dt * n;
+  F[Y][YAW] = v * dt * c;
+  F[BX][BX] = F[BY][BY] = phi;
+  const P = matmul(matmul(F, filter.P), transpose(F));
+  const along = (noise.odometryScaleSigma * v) ** 2 * dt, across = (noise.sideSlipSigma * v) ** 2 * dt;
+  P[X][X] += along * c * c + across * n * n;
+  P[Y][Y] += along * n * n + across * c * c;
+  P[X][Y] += (along - across) * c * n;
+  P[Y][X] += (along - across) * c * n;
+  P[YAW][YAW] += noise.yawRateSigma ** 2 * dt;
+  P[BX][BX] += filter.biasVar * (1 - phi * phi);
+  P[BY][BY] += filter.biasVar * (1 - phi * phi);
+  filter.P = P;
   filter.t = t;
 }
 
 function onGps(fix, heading) {
   if (fix.status.status < 0) return;
   const [ax, ay] = toLocal(fix.latitude, fix.longitude);
-  const r = Math.max(fix.position_covariance[0], fix.position_covariance[4], noise.minGpsSigma ** 2);
+  const reported = Math.max(fix.position_covariance[0], fix.position_covariance[4]);
+  const white = noise.gpsWhiteSigma ** 2;
   const t = stampNs(fix.header.stamp);
   const lever = (yaw) => [Math.cos(yaw) * vehicle.antenna[0] - Math.sin(yaw) * vehicle.antenna[1],
                           Math.sin(yaw) * vehicle.antenna[0] + Math.cos(yaw) * vehicle.antenna[1]];
   if (!filter.ready) {
+    // The first fix's bias is unknown: the pose inherits it (pose = fix - lever - bias).
+    const b = Math.max(reported - white, 0);
     const [lx, ly] = lever(heading.heading);
-    Object.assign(filter, { ready: true, t, x: ax - lx, y: ay - ly, yaw: heading.heading,
-                            P: [r, 0, 0, 0, r, 0, 0, 0, Math.max(heading.heading_variance, 0.01)] });
+    const P = zeros(5, 5);
+    P[X][X] = P[Y][Y] = reported;
+    P[BX][BX] = P[BY][BY] = b;
+    P[X][BX] = P[BX][X] = P[Y][BY] = P[BY][Y] = -b;
+    P[YAW][YAW] = heading.heading_variance;
+    Object.assign(filter, { ready: true, t, s: [ax - lx, ay - ly, heading.heading, 0, 0], P, biasVar: b });
     return;
   }
   predictTo(t);
-  const [lx, ly] = lever(filter.yaw);
-  const H = [1, 0, -ly, 0, 1, lx]; // 2x3
-  const P = filter.P;
-  const PHt = [0, 1, 2].map((i) => [0, 1].map((j) => P[3 * i] * H[3 * j] + P[3 * i + 1] * H[3 * j + 1] + P[3 * i + 2] * H[3 * j + 2]));
-  const S = [0, 1].map((i) => [0, 1].map((j) => H[3 * i] * PHt[0][j] + H[3 * i + 1] * PHt[1][j] + H[3 * i + 2] * PHt[2][j] + (i === j ? r : 0)));
+  const s = filter.s;
+  const [lx, ly] = lever(s[YAW]);
+  const H = [[1, 0, -ly, 1, 0], [0, 1, lx, 0, 1]];
+  const PHt = matmul(filter.P, transpose(H));
+  const S = matmul(H, PHt);
+  S[0][0] += white;
+  S[1][1] += white;
   const det = S[0][0] * S[1][1] - S[0][1] * S[1][0];
-  const Si = [[S[1][1] / det, -S[0][1] / det], [-S[1][0] / det, S[0][0] / det]];
-  const K = PHt.map((row) => [row[0] * Si[0][0] + row[1] * Si[1][0], row[0] * Si[0][1] + row[1] * Si[1][1]]);
-  const v = [ax - (filter.x + lx), ay - (filter.y + ly)];
-  filter.x += K[0][0] * v[0] + K[0][1] * v[1];
-  filter.y += K[1][0] * v[0] + K[1][1] * v[1];
-  filter.yaw = wrap(filter.yaw + K[2][0] * v[0] + K[2][1] * v[1]);
-  const IKH = [0, 1, 2].flatMap((i) => [0, 1, 2].map((j) => (i === j ? 1 : 0) - (K[i][0] * H[j] + K[i][1] * H[3 + j])));
-  filter.P = mul3(IKH, P);
+  const K = matmul(PHt, [[S[1][1] / det, -S[0][1] / det], [-S[1][0] / det, S[0][0] / det]]);
+  const v = [ax - (s[X] + lx + s[BX]), ay - (s[Y] + ly + s[BY])];
+  for (let i = 0; i < 5; i++) s[i] += K[i][0] * v[0] + K[i][1] * v[1];
+  s[YAW] = wrap(s[YAW]);
+  // Joseph form: stays symmetric and positive over thousands of updates.
+  const IKH = eye(5).map((row, i) => row.map((e, j) => e - (K[i][0] * H[0][j] + K[i][1] * H[1][j])));
+  const P = matmul(matmul(IKH, filter.P), transpose(IKH));
+  filter.P = P.map((row, i) => row.map((p, j) => p + white * (K[i][0] * K[j][0] + K[i][1] * K[j][1])));
 }
+
+// The (x, y, yaw) block, row major.
+const poseCovariance = () => [X, Y, YAW].flatMap((i) => [X, Y, YAW].map((j) => filter.P[i][j]));
 
 // ---- The stream.
 const stampNs = (s) => BigInt(s.sec) * 1000000000n + BigInt(s.nanosec);
@@ -168,8 +200,9 @@ function onRecord(record) {
         predictTo(t);
         const answer = { scan: scans++ };
         if (filter.ready) {
-          Object.assign(answer, { stamp_ns: Number(t), x: filter.x, y: filter.y, yaw: filter.yaw, covariance: filter.P });
-          estimates.push({ t, x: filter.x, y: filter.y, yaw: filter.yaw, P: [...filter.P] });
+          const [x, y, yaw] = filter.s, covariance = poseCovariance();
+          Object.assign(answer, { stamp_ns: Number(t), x, y, yaw, covariance });
+          estimates.push({ t, x, y, yaw, P: covariance });
         }
         process.stdout.write(JSON.stringify(answer) + "\n"); // a pipe: written before this returns
       }
