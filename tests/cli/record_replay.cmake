@@ -6,11 +6,15 @@
 # assets/vehicle.yaml changed (wheelbase and steering ratio, which the localizer's motion model uses):
 # the log carries the run's vehicle, so the estimates must still be the live run's.
 # -DLIDARLOOP=... -DSCENARIO=... -DWORKDIR=... [-DMETHOD=...: the run's method, recorded in the log] [-DDATA=...]
+# [-DLATENCY=MS: a fixed latency in closed loop; an exec: program's measured one is not repeatable]
 file(REMOVE_RECURSE ${WORKDIR})
 file(MAKE_DIRECTORY ${WORKDIR})
 set(method)
 if(METHOD)
   set(method --method ${METHOD})
+endif()
+if(LATENCY)
+  list(APPEND method --latency ${LATENCY})
 endif()
 foreach(threads 1 2)
   execute_process(COMMAND ${LIDARLOOP} run ${SCENARIO} --duration 6 --threads ${threads} ${method}
