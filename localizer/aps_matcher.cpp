@@ -137,6 +137,17 @@ struct ZScoreSums {
   int cells_used = 0;
 };
 
+// One row of offsets of Eq. 14's exponent for one cell of S: acc[i] += z-score^2 of the map cell
+// i * stride along. Inlined into both calls below, so the usual stride of one cell becomes plain
+// vector loads (a stride the compiler does not know is loaded a float at a time).
+[[gnu::always_inline]] inline void add_z_scores(float* acc, const float* map_mean, const float* map_sigma, int n,
+                                                int stride, float s_r, float s_sigma) {
+  for (int i = 0; i < n; ++i) {
+    const float d = map_mean[i * stride] - s_r, e = map_sigma[i * stride] + s_sigma;
+    acc[i] += d * d / (e * e);
+  }
+}
+
 // A cell of S takes part if it is usable and the map has data under it at every offset, so every
 // offset is scored on the same cells. The loop over offsets is innermost: each offset has its own
 // accumulator, so it vectorises.
@@ -159,11 +170,10 @@ ZScoreSums z_score_sums(const IntensityGrid& S, const MapWindow& m, const ApsSea
       for (int j = 0; j < oy; ++j) {
         const size_t base = m.index(c, r + j * step);
         float* acc = &sums.per_offset[size_t(j) * size_t(ox)];
-        for (int i = 0; i < ox; ++i) {
-          const size_t k = base + size_t(i * step);
-          const float d = map_mean[k] - s_r, e = map_sigma[k] + s_sigma;
-          acc[i] += d * d / (e * e);
-        }
+        if (step == 1)
+          add_z_scores(acc, map_mean + base, map_sigma + base, ox, 1, s_r, s_sigma);
+        else
+          add_z_scores(acc, map_mean + base, map_sigma + base, ox, step, s_r, s_sigma);
       }
     }
   }
@@ -229,10 +239,7 @@ Eigen::Vector2d IntensityGrid::cell_centre(int col, int row) const {
 IntensityGridBuilder::IntensityGridBuilder(const Pose2d& pose, const IntensityGridParams& params)
     : pose_(pose), params_(params) {
   check_grid_params(params, "IntensityGridBuilder");
-  const size_t cells = size_t(params.width_cells) * size_t(params.height_cells);
-  count_.assign(cells, 0);
-  sum_.assign(cells, 0.0);
-  sum_sq_.assign(cells, 0.0);
+  cells_.assign(size_t(params.width_cells) * size_t(params.height_cells), Sums{});
 }
 
 std::optional<size_t> intensity_cell_index(const IntensityGridParams& params, const Eigen::Vector2d& point_vehicle) {
@@ -313,10 +320,10 @@ bool IntensityGridBuilder::add(const Eigen::Vector2d& point_vehicle, double inte
   if (!std::isfinite(intensity)) return false;
   const std::optional<size_t> cell = intensity_cell_index(params_, point_vehicle);
   if (!cell) return false;
-  const size_t k = *cell;
-  ++count_[k];
-  sum_[k] += intensity;
-  sum_sq_[k] += intensity * intensity;
+  Sums& c = cells_[*cell];
+  ++c.count;
+  c.sum += intensity;
+  c.sum_sq += intensity * intensity;
   return true;
 }
 
@@ -329,20 +336,21 @@ void IntensityGridBuilder::add(const std::vector<Eigen::Vector2d>& points_vehicl
 }
 
 long IntensityGridBuilder::cells_with_more_than(uint32_t points) const {
-  return long(std::count_if(count_.begin(), count_.end(), [points](uint32_t n) { return n > points; }));
+  return long(std::count_if(cells_.begin(), cells_.end(), [points](const Sums& c) { return c.count > points; }));
 }
 
 IntensityGrid IntensityGridBuilder::grid() const {
   IntensityGrid grid;
   grid.pose = pose_;
   grid.params = params_;
-  grid.cells.resize(count_.size());
-  for (size_t k = 0; k < count_.size(); ++k) {
-    if (count_[k] == 0) continue;
+  grid.cells.resize(cells_.size());
+  for (size_t k = 0; k < cells_.size(); ++k) {
+    const Sums& c = cells_[k];
+    if (c.count == 0) continue;
     // Eq. 8's mean and spread from the sums; intensities are counts up to a few hundred, so the sum of
     // squares stays exact to far below a count's square even for thousands of points.
-    const double n = double(count_[k]), mean = sum_[k] / n;
-    grid.cells[k] = {count_[k], float(mean), float(std::max(0.0, sum_sq_[k] - sum_[k] * mean))};
+    const double n = double(c.count), mean = c.sum / n;
+    grid.cells[k] = {c.count, float(mean), float(std::max(0.0, c.sum_sq - c.sum * mean))};
   }
   return grid;
 }

@@ -97,8 +97,13 @@ class IntensityGridBuilder {
  private:
   Pose2d pose_;
   IntensityGridParams params_;
-  std::vector<uint32_t> count_;
-  std::vector<double> sum_, sum_sq_;
+  // A cell's sums side by side: points land on cells in firing order, all over S, and one cache line
+  // per point is a third of the misses of three arrays.
+  struct Sums {
+    double sum = 0, sum_sq = 0;
+    uint32_t count = 0;
+  };
+  std::vector<Sums> cells_;
 };
 
 struct ApsParams {

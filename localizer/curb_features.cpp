@@ -10,17 +10,22 @@
 
 namespace lidarloop {
 
-std::vector<Eigen::Vector2d> to_current_frame(const std::vector<Eigen::Vector2d>& previous, const Pose2d& m) {
-  const Eigen::Rotation2D<double> back(-m.yaw);
+void move_to_current_frame(std::vector<Eigen::Vector2d>& points, const Pose2d& m) {
+  // In place: S's older frames (tens of thousands of points) are moved every scan, and a new vector
+  // each time was an allocation and a copy. The matrix is Rotation2D's own, so the product is the same.
+  const Eigen::Matrix2d back = Eigen::Rotation2D<double>(-m.yaw).toRotationMatrix();
   const Eigen::Vector2d d(m.x, m.y);
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(previous.size());
-  for (const auto& c : previous) out.push_back(back * (c - d));
+  for (auto& c : points) c = back * (c - d);
+}
+
+std::vector<Eigen::Vector2d> to_current_frame(const std::vector<Eigen::Vector2d>& previous, const Pose2d& m) {
+  std::vector<Eigen::Vector2d> out(previous);
+  move_to_current_frame(out, m);
   return out;
 }
 
 void CurbAccumulator::add(const std::vector<Eigen::Vector2d>& curbs, const Pose2d& motion) {
-  for (auto& frame : history_) frame = to_current_frame(frame, motion);
+  for (auto& frame : history_) move_to_current_frame(frame, motion);
   const std::vector<Eigen::Vector2d> moved =
       to_current_frame(std::vector<Eigen::Vector2d>(origins_.begin(), origins_.end()), motion);
   origins_.assign(moved.begin(), moved.end());

@@ -23,6 +23,8 @@ struct CurbFeatureParams {
 // (relative(previous pose, current pose)). The paper prints R(dpsi); with dpsi the vehicle's own turn,
 // the points turn the other way.
 std::vector<Eigen::Vector2d> to_current_frame(const std::vector<Eigen::Vector2d>& previous, const Pose2d& motion);
+// The same in place (no copy of a frame that is moved every scan).
+void move_to_current_frame(std::vector<Eigen::Vector2d>& points, const Pose2d& motion);
 
 // Eq. 4: the last `frames` frames of curbs, kept in the current vehicle frame, with the positions the
 // vehicle had at each of them (the launching points of the beam model).

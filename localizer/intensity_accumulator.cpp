@@ -23,7 +23,7 @@ void IntensityAccumulator::add(std::vector<Eigen::Vector2d> ground, std::vector<
                                 std::to_string(intensities.size()) + " intensities");
   last_turn_rad_ = motion.yaw;
   for (Frame& frame : history_) {
-    frame.ground = to_current_frame(frame.ground, motion);  // Eq. 5
+    move_to_current_frame(frame.ground, motion);  // Eq. 5
     frame.turn_rad += motion.yaw;
   }
   history_.push_front({std::move(ground), std::move(intensities), 0.0});
