@@ -29,9 +29,10 @@
 // frame: the frame that coincides with base_link when the body rests on flat ground, and that pitches
 // and rolls about the centre of mass and heaves with it (identity for a rigid body). The LiDAR is
 // mounted on the body: its true pose is base_link * body * mount, with the mount from /tf_static.
-// Header stamps are measurement times; a message's MCAP log_time is when the recorder received it in
-// simulation time (never earlier than the log time of the message before it), so replaying in
-// log-time order gives exactly the order of the live run.
+// Header stamps are measurement times, except /vehicle/report's: a CAN frame is stamped when the host
+// received it (the bus latency plus the host clock's jitter). A message's MCAP log_time is the
+// largest stamp recorded so far (never earlier than the log time of the message before it), so
+// replaying in log-time order gives exactly the order of the live run.
 namespace lidarloop::log_topics {
 
 inline constexpr const char* scan = "/lidar/points";
