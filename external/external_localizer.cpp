@@ -63,6 +63,12 @@ std::map<std::string, std::string> external_metadata(const HdMap& map, const Loc
           {"vehicle_lf_m", exact(v.lf)},
           {"vehicle_lr_m", exact(v.lr)},
           {"vehicle_steering_ratio", exact(v.steering_ratio)},
+          // The rest of Eq. 19's parameters, so that a program can predict as the built-in localizer does.
+          {"vehicle_mass_kg", exact(v.mass)},
+          {"vehicle_yaw_inertia_kg_m2", exact(v.yaw_inertia)},
+          {"vehicle_cornering_stiffness_front_n_per_rad", exact(v.cornering_stiffness_front)},
+          {"vehicle_cornering_stiffness_rear_n_per_rad", exact(v.cornering_stiffness_rear)},
+          {"vehicle_kinematic_below_mps", exact(v.kinematic_below)},
           {"gps_antenna_x_m", exact(params.gps_antenna.x())},
           {"gps_antenna_y_m", exact(params.gps_antenna.y())},
           {"gps_antenna_z_m", exact(params.gps_antenna.z())}};
