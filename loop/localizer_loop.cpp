@@ -143,7 +143,6 @@ class PipelinedSink : public StreamSink {
     if (failure_) std::rethrow_exception(failure_);
     return estimates_[k - handed_out_];
   }
-  size_t handed_out() const { return handed_out_; }
 
   // Waits for the last scan's estimate, hands out everything held back and stops the worker once it
   // has processed everything; rethrows what the localizers threw. Call after the run.
@@ -325,7 +324,7 @@ class EstimateDelivery {
       done_ns_ = *due_ns_;
       due_ns_.reset();
       ++next_;
-      while (first_handed_out_ < std::min(next_, sink_.handed_out())) {
+      while (first_handed_out_ < next_ && !handed_out_.empty()) {  // the controller has had these
         handed_out_.pop_front();
         ++first_handed_out_;
       }
