@@ -149,18 +149,26 @@ double RoadSurface::crown(const Eigen::Vector2d& p) const {
   return found ? z : 0.0;
 }
 
-Eigen::Isometry3d rest_on_ground(const Pose2d& pose, const GroundHeight& ground, double wheelbase, double track) {
+GroundContact ground_contact(const Pose2d& pose, const GroundHeight& ground, double wheelbase, double track) {
   const Eigen::Vector2d forward(std::cos(pose.yaw), std::sin(pose.yaw)), left(-forward.y(), forward.x());
   const Eigen::Vector2d rear(pose.x, pose.y), front = rear + forward * wheelbase;
   const double rl = ground(rear + left * (track / 2)), rr = ground(rear - left * (track / 2));
   const double fl = ground(front + left * (track / 2)), fr = ground(front - left * (track / 2));
-  const double pitch = -std::atan2((fl + fr) - (rl + rr), 2 * wheelbase);  // nose up is negative about y
-  const double roll = std::atan2((rl + fl) - (rr + fr), 2 * track);        // left side up is positive
+  return {(rl + rr) / 2, -std::atan2((fl + fr) - (rl + rr), 2 * wheelbase),  // nose up is negative about y
+          std::atan2((rl + fl) - (rr + fr), 2 * track)};                     // left side up is positive
+}
+
+Eigen::Isometry3d on_ground(const Pose2d& pose, const GroundContact& contact) {
   Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
-  m.translate(Eigen::Vector3d(pose.x, pose.y, (rl + rr) / 2));
-  m.rotate(Eigen::AngleAxisd(pose.yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()));
+  m.translate(Eigen::Vector3d(pose.x, pose.y, contact.z));
+  m.rotate(Eigen::AngleAxisd(pose.yaw, Eigen::Vector3d::UnitZ()) *
+           Eigen::AngleAxisd(contact.pitch, Eigen::Vector3d::UnitY()) *
+           Eigen::AngleAxisd(contact.roll, Eigen::Vector3d::UnitX()));
   return m;
+}
+
+Eigen::Isometry3d rest_on_ground(const Pose2d& pose, const GroundHeight& ground, double wheelbase, double track) {
+  return on_ground(pose, ground_contact(pose, ground, wheelbase, track));
 }
 
 }  // namespace lidarloop

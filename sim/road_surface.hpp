@@ -74,6 +74,14 @@ using GroundHeight = std::function<double(const Eigen::Vector2d&)>;
 // the mid-points of the axles and of the sides.
 Eigen::Isometry3d rest_on_ground(const Pose2d& pose, const GroundHeight& ground, double wheelbase, double track);
 
+// The same in two halves, for callers that interpolate the contact between poses: where the four
+// wheels put the rear axle's centre (height) and the plane (pitch, roll), then the body's pose on it.
+struct GroundContact {
+  double z = 0, pitch = 0, roll = 0;
+};
+GroundContact ground_contact(const Pose2d& pose, const GroundHeight& ground, double wheelbase, double track);
+Eigen::Isometry3d on_ground(const Pose2d& pose, const GroundContact& contact);
+
 // ISO 8608 displacement PSD at the reference spatial frequency 0.1 cycles/m, m^3, for classes A-E.
 double iso8608_psd(char road_class);
 

@@ -89,8 +89,9 @@ class Simulation {
   GroundHeight pavement_;  // where the ego's wheels roll
   VehicleBody body_;       // the sprung body the LiDAR is mounted on
   int64_t scan_index_ = 0;
-  std::vector<Pose2d> trajectory_;             // rear-axle pose at every step of the scan being recorded
-  std::vector<BodyAttitude> body_trajectory_;  // the body on the ground plane at the same steps
+  std::vector<Pose2d> trajectory_;                // rear-axle pose at every step of the scan being recorded
+  std::vector<BodyAttitude> body_trajectory_;     // the body on the ground plane at the same steps
+  std::vector<GroundContact> ground_trajectory_;  // the wheels' contact with the pavement at the same steps
   int64_t trajectory_start_ns_ = 0;
   CurbVisibilityConfig curb_visibility_;
   std::vector<Eigen::Vector3f> curb_tops_;  // the world's curbs, sampled once

@@ -80,6 +80,43 @@ TEST(RoadRealism, RoughnessHasTheRmsOfItsIsoClass) {
   EXPECT_EQ(iso8608_psd('B'), 64e-6);
 }
 
+// The simulation finds the wheels' contact at each 1 ms integration step and interpolates it for the
+// firings between. At 30 m/s on the roughest class (D) with 0.5 m its shortest wave, a step is 3 cm:
+// the interpolated pose must move a return at the HDL-32E's 100 m range by less than half its range
+// noise (2 cm, 1 sigma) from where resting the car there puts it.
+TEST(RoadRealism, GroundContactInterpolatedOverAStepIsTheRestingPose) {
+  const WorldDescription d = parse_world_description(
+      kHeader +
+          "geometry: {roughness_class: D, roughness_min_wavelength: 0.5, roughness_max_wavelength: 10}\n"
+          "roads:\n  - {name: r, points: [[0, 0], [10, 0]]}\n",
+      "w.yaml");
+  const RoadSurface surface(d);
+  const GroundHeight ground = [&](const Eigen::Vector2d& p) { return surface.roughness(p); };
+  constexpr double kWheelbase = 2.7, kTrack = 1.6, kStep = 30.0 * 1e-3;  // m: 30 m/s for 1 ms
+  double worst_m = 0, worst_rad = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const double yaw = 0.37 * k;
+    const Pose2d a{0.61 * k, -0.43 * k, yaw}, b{a.x + kStep * std::cos(yaw), a.y + kStep * std::sin(yaw), yaw};
+    const GroundContact ca = ground_contact(a, ground, kWheelbase, kTrack);
+    const GroundContact cb = ground_contact(b, ground, kWheelbase, kTrack);
+    for (double f : {0.25, 0.5, 0.75}) {
+      const Pose2d p{a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), yaw};
+      const Eigen::Isometry3d interpolated = on_ground(
+          p, {ca.z + f * (cb.z - ca.z), ca.pitch + f * (cb.pitch - ca.pitch), ca.roll + f * (cb.roll - ca.roll)});
+      const Eigen::Isometry3d resting = rest_on_ground(p, ground, kWheelbase, kTrack);
+      worst_m = std::max(worst_m, (interpolated.translation() - resting.translation()).norm());
+      worst_rad = std::max(worst_rad, Eigen::AngleAxisd(interpolated.linear().transpose() * resting.linear()).angle());
+    }
+    // At the step itself the two halves are rest_on_ground, to the bit.
+    ASSERT_TRUE(on_ground(a, ca).isApprox(rest_on_ground(a, ground, kWheelbase, kTrack), 0.0));
+  }
+  constexpr double kMaxRange = 100, kHalfRangeNoise = 0.01;  // m
+  EXPECT_LT(worst_m + worst_rad * kMaxRange, kHalfRangeNoise);
+  EXPECT_GT(worst_m, 0.0);  // the roughness is there to interpolate
+  RecordProperty("worst_mm", std::to_string(worst_m * 1e3));
+  RecordProperty("worst_deg", std::to_string(worst_rad * 180 / std::numbers::pi));
+}
+
 // A straight road along x with the curb on its right at y = -4 and the given curb keys.
 struct CurbCase {
   std::string keys;
