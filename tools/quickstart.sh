@@ -40,10 +40,12 @@ if [ "$what" = run ]; then
   exec build/tools/lidarloop run scenarios/dynamic_campus.yaml --out build/out/dynamic_campus
 fi
 
-build build -DCMAKE_BUILD_TYPE=Release -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=OFF
+# The optimized build runs the command-line, scenario, map, log and sweep tests, and the few unit tests
+# too slow to run instrumented (LIDARLOOP_UNIT_TESTS=slow: tests/CMakeLists.txt lists them and why).
+build build -DCMAKE_BUILD_TYPE=Release -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=OFF -DLIDARLOOP_UNIT_TESTS=slow
 expect_tests build unit cli scenario map node sweep external
 ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs"
-# The unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer, and the libFuzzer targets
+# Every other unit test under AddressSanitizer and UndefinedBehaviorSanitizer, and the libFuzzer targets
 # (fuzz/) in the same instrumented build, by clang: only what they run is built, at -O1 with line tables
 # only (-g1: file and line in the sanitizers' stack traces), to keep the instrumented build, which CI
 # runs on two cores, short. A folder configured by another compiler is started afresh.
@@ -52,35 +54,12 @@ if [ -f build-sanitize/CMakeCache.txt ] && ! grep -q '^CMAKE_CXX_COMPILER:[A-Z]*
 fi
 configure build-sanitize -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
   -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=ON -DLIDARLOOP_FUZZ=ON -DLIDARLOOP_BUILD_BENCHMARKS=OFF \
-  -DLIDARLOOP_UNITY_BUILD=OFF
+  -DLIDARLOOP_UNITY_BUILD=OFF -DLIDARLOOP_UNIT_TESTS=fast
 cmake --build build-sanitize -j "$jobs" --target unit_tests fuzz_targets
-expect_tests build-sanitize unit fuzz
-# Left out here, run in the pass above only, each because a shorter test runs the same code
-# instrumented (each took 30-65 s instrumented, the shorter ones 10-37 s):
-#   four mapping drives over a whole test world: WorldChanges.ACarParkedOnly... surveys a 40 m road twice,
-#     MappingDrive.SameMapBytesAtOneAndTwoThreads... a crosswalk road with one and two threads;
-#   the large world's build, and the campus's curbs against its GeoJSON: WorldBuilderCampus.* build the
-#     campus and check its curb faces;
-#   the campus scan against the whole curb map: CampusScan.CurbFacesShowTheirHeightAboveThePavement;
-#   four curb detector accuracy runs over many campus scans: CurbDetector.FindsExactlyTheOraclesCurbs...
-#     (campus scans with traffic) and ...OnRandomRoads;
-#   two 20-40 s drives of the whole simulation, one of them at two thread counts: Simulation.ABusOvertaking...,
-#     VehicleBody.* and MountError.* drive it for a few seconds;
-#   a minute's drive without GPS: LocalizerGps.* and Localizer.CanGaps... run the same filter paths;
-#   the ideal profile's world: RealismProfiles' other tests build the profiles' worlds.
-skipped=(
-  MappingDrive.PlacesItsScansWithTheSurveyedPoses MappingDrive.SameSeedSameMapBytesOtherSeedOtherMap
-  IntensityLayer.TrafficRaisesTheVarianceOfTheCellsItCrosses IntensityLayer.PaintIsBrighterThanAsphaltInTheSurveyedMap
-  WorldBuilderLarge.IsAbout1800By1200AndBuilds WorldBuilderCampus.GeoJsonCurbsCoincideWithMeshedCurbEdges
-  CampusScan.CurbsInTheScanLieOnTheCurbMap
-  CurbDetector.KeepsItsPrecisionOnRealisticRoadsAndCurbs CurbDetector.TheTypicalSensorsMixedReturnsCostPrecisionBesideTraffic
-  CurbDetector.FindsTheCampusCurbsWithHighPrecisionAndRecall CurbDetector.KeepsItsPrecisionAndRecallWithTrafficBesideTheCurbs
-  Simulation.TheEgoDrivesItsRouteAndStopsWhereTold Simulation.SameSeedGivesIdenticalStreamsAtAnyThreadCount
-  Localizer.AMinuteWithoutGpsIsReportedAndSurvived RealismProfiles.TheIdealMapsWorldIsOnIdealGround
-)
-skip_regex="^($(IFS='|'; echo "${skipped[*]//./\\.}"))\$"
+expect_tests build-sanitize unit fuzz link
 # With them, every reader of outside files fuzzed for a bounded time (LIDARLOOP_FUZZ_SECONDS each): a
-# crash, a hang, a sanitizer report or an exception other than the reader's InputError fails. One ctest
-# for both, so that neither waits with a core idle for the other's last test.
+# crash, a hang, a sanitizer report or an exception other than the reader's InputError fails; and the
+# check that the localizer's and the logs' tests link no simulator code. One ctest for all, so that none
+# waits with a core idle for another's last test.
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j "$jobs" -L '^(unit|fuzz)$' -E "$skip_regex"
+  ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j "$jobs" -L '^(unit|fuzz|link)$'
