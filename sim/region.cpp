@@ -1,6 +1,7 @@
 #include "sim/region.hpp"
 
 #include <cmath>
+#include <optional>
 #include <unordered_map>
 
 namespace lidarloop::region {
@@ -35,6 +36,44 @@ Paths square(cInt x0, cInt y0, cInt size) {
   return {{{x0, y0}, {x0 + size, y0}, {x0 + size, y0 + size}, {x0, y0 + size}}};
 }
 
+// Where a square stands against a region (nonzero winding, as Clipper fills it).
+enum class Placement { inside, outside, crossed };
+
+// An axis-aligned square, in Clipper's integer units.
+struct Square {
+  cInt x0, y0, size;
+};
+
+// Inside or outside only when no edge of the region comes within the closed square's bounding box,
+// except edges on the sides of `clipped_to`, the square the region was cut to, which the square lies in:
+// they cannot enter it. The square then lies in one face of the region, whose winding number its centre
+// gives exactly (integer coordinates). Anything nearer is `crossed`, for Clipper to cut.
+Placement place_square(const Paths& region, const std::optional<Square>& clipped_to, const Square& q) {
+  if (q.size < 2) return Placement::crossed;  // no centre off its sides
+  const cInt x1 = q.x0 + q.size, y1 = q.y0 + q.size;
+  auto on_side = [&](const IntPoint& a, const IntPoint& b) {
+    if (!clipped_to) return false;
+    const Square& c = *clipped_to;
+    return (a.X == b.X && (a.X == c.x0 || a.X == c.x0 + c.size)) ||
+           (a.Y == b.Y && (a.Y == c.y0 || a.Y == c.y0 + c.size));
+  };
+  const IntPoint centre{q.x0 + q.size / 2, q.y0 + q.size / 2};
+  int winding = 0;
+  for (const Path& path : region)
+    for (size_t i = 0; i < path.size(); ++i) {
+      const IntPoint &a = path[i], &b = path[(i + 1) % path.size()];
+      if (std::max(a.X, b.X) >= q.x0 && std::min(a.X, b.X) <= x1 && std::max(a.Y, b.Y) >= q.y0 &&
+          std::min(a.Y, b.Y) <= y1 && !on_side(a, b))
+        return Placement::crossed;
+      if (a.Y <= centre.Y) {
+        if (b.Y > centre.Y && cross(a, b, centre) > 0) ++winding;
+      } else if (b.Y <= centre.Y && cross(a, b, centre) < 0) {
+        --winding;
+      }
+    }
+  return winding != 0 ? Placement::inside : Placement::outside;
+}
+
 struct IntPointHash {
   size_t operator()(const IntPoint& p) const { return std::hash<uint64_t>()(uint64_t(p.X) * 1000003u + uint64_t(p.Y)); }
 };
@@ -64,7 +103,23 @@ struct Mesher {
       mesh.add_triangle(base + t[0], base + t[1], base + t[2], material);
   }
 
-  void node(const Paths& parent, cInt x0, cInt y0, cInt size) {
+  void fill(cInt x0, cInt y0, cInt size) {
+    const cInt step = std::min(size, max_square);
+    for (cInt y = y0; y < y0 + size; y += step)
+      for (cInt x = x0; x < x0 + size; x += step) emit(square(x, y, step)[0]);
+  }
+
+  // `parent` is the region cut to `clipped_to` (the root's is the whole region).
+  void node(const Paths& parent, const std::optional<Square>& clipped_to, cInt x0, cInt y0, cInt size) {
+    // Most squares lie wholly in or out of the region, and clipping them is most of the meshing's time.
+    switch (place_square(parent, clipped_to, {x0, y0, size})) {
+      case Placement::outside:
+        return;
+      case Placement::inside:
+        return fill(x0, y0, size);
+      case Placement::crossed:
+        break;
+    }
     const Paths piece = intersect(parent, square(x0, y0, size));
     if (piece.empty()) return;
     double covered = 0;
@@ -73,15 +128,10 @@ struct Mesher {
       covered += ClipperLib::Area(p);
       has_hole = has_hole || !ClipperLib::Orientation(p);
     }
-    if (covered >= double(size) * double(size) * (1 - 1e-9)) {
-      const cInt step = std::min(size, max_square);
-      for (cInt y = y0; y < y0 + size; y += step)
-        for (cInt x = x0; x < x0 + size; x += step) emit(square(x, y, step)[0]);
-      return;
-    }
+    if (covered >= double(size) * double(size) * (1 - 1e-9)) return fill(x0, y0, size);
     if (size > leaf_size || (has_hole && size > min_size)) {
       const cInt h = size / 2;
-      for (int k = 0; k < 4; ++k) node(piece, x0 + (k & 1) * h, y0 + (k >> 1) * h, h);
+      for (int k = 0; k < 4; ++k) node(piece, Square{x0, y0, size}, x0 + (k & 1) * h, y0 + (k >> 1) * h, h);
       return;
     }
     for (auto p : piece) {
@@ -195,7 +245,7 @@ void mesh_region(const Paths& region, double tile_size, const std::function<floa
   while (double(full) * 2 <= max_full && full < size) full *= 2;
   while (double(full) > max_full && full > 1) full /= 2;
   Mesher mesher{height, material, mesh, leaf, std::max<cInt>(leaf / 16, 1), full};
-  mesher.node(region, x0, y0, size);
+  mesher.node(region, std::nullopt, x0, y0, size);
 }
 
 std::vector<std::array<uint32_t, 3>> triangulate_polygon(const Path& polygon) {
