@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -24,11 +25,33 @@ namespace lidarloop {
 
 namespace {
 
-constexpr double kTrafficSpacing = 45.0;  // m between oncoming vehicles
-constexpr double kTrafficSpeed = 9.0;     // m/s
-constexpr double kCastMargin = 1.0;       // m cast beyond max_range: 50 times the range noise (2 cm)
-constexpr double kRestStep = 0.1;         // m: pitch and roll follow roughness of 0.5 m wavelength and more
+constexpr double kTrafficSpacing = 45.0;         // m between oncoming vehicles
+constexpr double kTrafficSpeed = 9.0;            // m/s
+constexpr double kCastMargin = 1.0;              // m cast beyond max_range: 50 times the range noise (2 cm)
+constexpr double kRestStep = 0.1;                // m: pitch and roll follow roughness of 0.5 m wavelength and more
+constexpr double kAboveTiltMargin = 0.1 * kDeg;  // rad: a laser this far above the sensor's tilt looks up
 constexpr ActorType kTrafficTypes[] = {ActorType::car, ActorType::car, ActorType::truck, ActorType::bus};
+
+// The lasers that can give the intensity layer a point, the others being aimed higher above the sensor's
+// horizon than the sensor is tilted (by its body and mount) during the scan: their points all lie
+// above the sensor, which stands more than max_ground_height over the ground under the car. Points
+// that high are dropped anyway, and on level ground a quarter of the lasers look that high.
+uint32_t ground_lasers(const Hdl32eConfig& lidar, const std::vector<Eigen::Isometry3d>& vehicle_at_cycle,
+                       double max_ground_height) {
+  double tilt = 0, height = std::numeric_limits<double>::infinity();
+  for (const Eigen::Isometry3d& vehicle : vehicle_at_cycle) {
+    const Eigen::Isometry3d sensor = vehicle * lidar.mount();
+    // The angle between the sensor's axis and the vertical: a beam at elevation e points at least
+    // e - tilt above the horizon.
+    tilt = std::max(tilt, std::acos(std::clamp(sensor.linear()(2, 2), -1.0, 1.0)));
+    height = std::min(height, sensor.translation().z() - vehicle.translation().z());
+  }
+  if (!(height > max_ground_height)) return LidarScanner::kAllLasers;
+  uint32_t lasers = 0;
+  for (int laser = 0; laser < kHdl32eLasers; ++laser)
+    if (lidar.elevation_deg[size_t(laser)] * kDeg - tilt <= kAboveTiltMargin) lasers |= 1u << laser;
+  return lasers;
+}
 
 }  // namespace
 
@@ -281,10 +304,13 @@ PartMaps drive_part(const DriveSetup& d, const IntensityMapHeader& header, const
     const int64_t stamp = k * period;
     for (size_t c = 0; c < at_cycle.size(); ++c) at_cycle[c] = resting(stamp + int64_t(c) * cycle_ns);
     grid_stamp = stamp;
-    const PointCloud cloud = d.scanner.scan(scene, vehicle, stamp, o.seed, actor_poses);
+    PointMapBuilder* const point_layer = maps.points && k % o.point_scan_stride == 0 ? &*maps.points : nullptr;
+    // A scan for the point layer keeps every surface; one for the intensity layer only the ground.
+    const uint32_t lasers =
+        point_layer ? LidarScanner::kAllLasers : ground_lasers(d.lidar, at_cycle, o.max_ground_height);
+    const PointCloud cloud = d.scanner.scan(scene, vehicle, stamp, o.seed, actor_poses, nullptr, lasers);
     // The survey places each point with its pose at the point's own firing cycle.
     uint32_t cycle = UINT32_MAX;
-    PointMapBuilder* const point_layer = maps.points && k % o.point_scan_stride == 0 ? &*maps.points : nullptr;
     Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
     for (const LidarPoint& p : cloud.points) {
       if (double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z > o.max_range * o.max_range) continue;

@@ -119,7 +119,7 @@ std::vector<LidarRay> LidarScanner::rays(const PoseAt& vehicle_pose, int64_t sta
 }
 
 PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64_t stamp_ns, uint64_t seed,
-                              const ActorPoses& actor_poses, Hdl32eRotation* wire) const {
+                              const ActorPoses& actor_poses, Hdl32eRotation* wire, uint32_t lasers) const {
   const auto poses = cycle_poses(vehicle_pose, stamp_ns);
   const int cycles = int(poses.size());
   const CounterRng rng(seed, uint64_t(stamp_ns));
@@ -196,10 +196,11 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
       bool found[kPacket];
       for (int packet = range.begin(); packet != range.end(); ++packet) {
         const int slot = packet % kHdl32eLasers, cycle0 = first_cycle + (packet / kHdl32eLasers) * kPacket;
+        const int ring = config_.firing_order[slot];
+        if (!((lasers >> ring) & 1u)) continue;
         const int count = std::min(kPacket, end_cycle - cycle0);
         for (int k = 0; k < count; ++k) rays[k] = ray(poses[cycle0 + k], cycle0 + k, slot);
         scene.intersect8(rays, count, tnear, tfar, hits, found);
-        const int ring = config_.firing_order[slot];
         for (int k = 0; k < count; ++k) {
           const int cycle = cycle0 + k;
           const size_t i = size_t(cycle) * kHdl32eLasers + size_t(slot);

@@ -53,8 +53,12 @@ class LidarScanner {
   const WeatherConfig& weather() const { return weather_; }
 
   // `wire`, when given, receives the scan's blocks as the sensor sends them, starting at stamp_ns.
+  // Only the lasers whose bit (by laser id, 0-31) is set in `lasers` are cast; the others return
+  // nothing. The random draws are by firing, so the lasers cast give the same returns either way.
   PointCloud scan(RayScene& scene, const PoseAt& vehicle_pose, int64_t stamp_ns, uint64_t seed,
-                  const ActorPoses& actor_poses = {}, Hdl32eRotation* wire = nullptr) const;
+                  const ActorPoses& actor_poses = {}, Hdl32eRotation* wire = nullptr,
+                  uint32_t lasers = kAllLasers) const;
+  static constexpr uint32_t kAllLasers = 0xffffffffu;
 
   // The rays of one scan in firing order (cycle-major, then firing slot); scan() casts exactly these.
   std::vector<LidarRay> rays(const PoseAt& vehicle_pose, int64_t stamp_ns) const;
