@@ -233,6 +233,31 @@ poles:
   }
 }
 
+// The mapping drive casts only the lasers that can see the ground: a masked scan is the whole scan's
+// points of the lasers cast, to the bit (mixed returns and dropouts on: their draws are by firing).
+TEST(Hdl32e, AScanOfSomeLasersIsTheWholeScansPointsOfThoseLasers) {
+  Hdl32eConfig config = hdl32e_config_for(Realism::typical);
+  config.dropout_probability = 0.05;
+  const TriangleMesh mesh = walled_plane();
+  RayScene scene(mesh);
+  const LidarScanner scanner(config, test::materials());
+  const PoseAt pose = constant_twist(Eigen::Isometry3d::Identity(), 0, 8.0, 0.1);
+  const uint32_t lasers = 0x0000ffffu | (1u << 20) | (1u << 31);  // the lower half, one mid and the top laser
+  const PointCloud whole = scanner.scan(scene, pose, 0, 3), some = scanner.scan(scene, pose, 0, 3, {}, nullptr, lasers);
+  std::vector<LidarPoint> expected;
+  for (const LidarPoint& p : whole.points)
+    if ((lasers >> p.ring) & 1u) expected.push_back(p);
+  ASSERT_GT(expected.size(), 20000u);
+  ASSERT_LT(expected.size(), whole.points.size());
+  ASSERT_EQ(some.points.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) {
+    const LidarPoint &a = expected[i], &b = some.points[i];
+    ASSERT_TRUE(a.x == b.x && a.y == b.y && a.z == b.z && a.intensity == b.intensity && a.ring == b.ring &&
+                a.t_ns == b.t_ns)
+        << "point " << i << " differs";
+  }
+}
+
 TEST(Hdl32e, ConfigOverridesAreValidated) {
   Hdl32eConfig c;
   const YamlReader ok = YamlReader::from_string("rotation_hz: 20\nmount_xyz: [1, 0, 2]\n", "lidar.yaml");
