@@ -22,14 +22,18 @@ Eigen::Vector2d vehicle_to_world(const Pose2d& pose, const Eigen::Vector2d& p) {
 
 namespace {
 
-// Cell of a vehicle-frame point, shared by the projection (Eq. 1) and the queries so both agree.
-std::optional<cv::Point> cell_of(const CorridorParams& params, const Eigen::Vector2d& p) {
-  if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || params.cell_m <= 0) return std::nullopt;
+// Cell of a vehicle-frame point (x, y), shared by the projection (Eq. 1) and the queries so both agree.
+std::optional<cv::Point> cell_of(const CorridorParams& params, double x, double y) {
+  if (!std::isfinite(x) || !std::isfinite(y) || params.cell_m <= 0) return std::nullopt;
   // floor, not truncation, so the cells either side of 0 are not merged into one double-size cell.
-  const double col = std::floor(p.x() / params.cell_m) + params.width_cells / 2;
-  const double row = std::floor(-p.y() / params.cell_m) + params.height_cells / 2;
+  const double col = std::floor(x / params.cell_m) + params.width_cells / 2;
+  const double row = std::floor(-y / params.cell_m) + params.height_cells / 2;
   if (col < 0 || row < 0 || col >= params.width_cells || row >= params.height_cells) return std::nullopt;
   return cv::Point(static_cast<int>(col), static_cast<int>(row));
+}
+
+std::optional<cv::Point> cell_of(const CorridorParams& params, const Eigen::Vector2d& p) {
+  return cell_of(params, p.x(), p.y());
 }
 
 }  // namespace
@@ -42,6 +46,17 @@ bool DrivingCorridor::contains(const Eigen::Vector2d& p_vehicle) const {
   if (mask.empty()) return false;
   const auto c = cell(p_vehicle);
   return c && mask.at<std::uint8_t>(*c) != 0;
+}
+
+std::vector<size_t> DrivingCorridor::inside(const std::vector<Eigen::Vector3d>& points_vehicle) const {
+  std::vector<size_t> out;
+  if (mask.empty()) return out;
+  out.reserve(points_vehicle.size());
+  for (size_t i = 0; i < points_vehicle.size(); ++i) {
+    const auto c = cell_of(params, points_vehicle[i].x(), points_vehicle[i].y());
+    if (c && mask.at<std::uint8_t>(*c) != 0) out.push_back(i);
+  }
+  return out;
 }
 
 DrivingCorridor extract_driving_corridor(const std::vector<Eigen::Vector2d>& curbs_world, const Pose2d& pose,

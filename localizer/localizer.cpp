@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include <Eigen/Dense>
 
@@ -57,8 +58,12 @@ std::vector<size_t> corridor_points(const ScanPoints& points, const CurbLayer& c
   const bool have_corridor = !corridor.mask.empty();
   if (!have_corridor) e.health |= kNoCorridor;
   std::vector<size_t> inside;
-  for (size_t i = 0; i < points.size(); ++i)
-    if (!have_corridor || corridor.contains(points.xyz[i].head<2>())) inside.push_back(i);
+  if (have_corridor) {
+    inside = corridor.inside(points.xyz);
+  } else {
+    inside.resize(points.size());
+    std::iota(inside.begin(), inside.end(), size_t{0});
+  }
   e.corridor_points = inside.size();
   return inside;
 }
