@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace lidarloop {
 
@@ -26,7 +27,10 @@ constexpr double kRoundingSlack = 1e-9, kRoundingFloor = 1e-12;  // -, m^2
 // The scan's ground-looking points grouped by ring, ring after ring, each in firing (azimuth) order.
 // The scan interleaves the rings, so walking one ring in place would stride across all the others.
 struct RingPoints {
-  std::vector<double> x, y, z, range;            // range: horizontal distance from the vehicle
+  // range: horizontal distance from the vehicle. Arrays left uninitialised (new double[n], not a
+  // vector): every place a ring's range covers is written, the rest never read, and zeroing four
+  // scan-sized arrays first was a few percent of the detector.
+  std::unique_ptr<double[]> x, y, z, range;
   std::array<size_t, kMaxRings> begin{}, end{};  // ring r is [begin[r], end[r])
 };
 
@@ -41,7 +45,7 @@ RingPoints group_by_ring(const std::vector<Eigen::Vector3d>& points, const std::
   for (size_t i = 0; i < n; ++i) ++count[std::min<size_t>(rings[i], kDiscard)];
   for (size_t r = 1; r <= kDiscard; ++r) next[r] = next[r - 1] + count[r - 1];
   RingPoints g;
-  for (auto* v : {&g.x, &g.y, &g.z, &g.range}) v->resize(next[kDiscard] + 1);
+  for (auto* v : {&g.x, &g.y, &g.z, &g.range}) v->reset(new double[next[kDiscard] + 1]);
   std::copy_n(next.begin(), kMaxRings, g.begin.begin());
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d& q = points[i];
@@ -74,8 +78,8 @@ struct Ring {
   void load(const RingPoints& g, int ring) {
     const size_t b = g.begin[size_t(ring)];
     n = g.end[size_t(ring)] - b;
-    x = g.x.data() + b, y = g.y.data() + b, z = g.z.data() + b;
-    const double* range = g.range.data() + b;
+    x = g.x.get() + b, y = g.y.get() + b, z = g.z.get() + b;
+    const double* range = g.range.get() + b;
     s.resize(n + kLookahead);
     segment.resize(n + 1);
     z_sum.resize(n + 1);

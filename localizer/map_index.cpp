@@ -109,7 +109,10 @@ std::pair<size_t, double> MapIndex::nearest_within(const Eigen::Vector2d& p, dou
     const auto found = nearest(p);
     return found.second <= radius ? found : none;
   }
-  const double fc = std::floor((p.x() - b.origin.x()) / b.size), fr = std::floor((p.y() - b.origin.y()) / b.size);
+  // The query's bucket, x and y divided as one pair (one vector division, each lane rounded as the
+  // scalar one is).
+  const Eigen::Array2d f = ((p - b.origin).array() / b.size).floor();
+  const double fc = f.x(), fr = f.y();
   double best_squared = radius * radius;
   size_t best = SIZE_MAX;
   // Buckets r0..r1 x c0..c1, clamped to the grid in double first (so a query far off the map neither
