@@ -272,6 +272,17 @@ std::optional<size_t> intensity_cell_index(const IntensityGridParams& params, co
   return CellIndexer(params)(point_vehicle);
 }
 
+std::vector<char> in_marked_cells(const IntensityGridParams& params, const std::vector<char>& marked,
+                                  const std::vector<Eigen::Vector3d>& points, const std::vector<size_t>& indices) {
+  const CellIndexer cell_index(params);
+  std::vector<char> out(indices.size(), 0);
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const std::optional<size_t> cell = cell_index(points[indices[k]].head<2>());
+    out[k] = cell && marked[*cell];
+  }
+  return out;
+}
+
 std::vector<char> cells_near_obstacles(const std::vector<Eigen::Vector2d>& obstacles, const IntensityGridParams& p) {
   check_grid_params(p, "cells_near_obstacles");
   const int w = p.width_cells, h = p.height_cells;

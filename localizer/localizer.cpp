@@ -110,14 +110,15 @@ IntensityGrid intensity_grid(const ScanPoints& points, const std::vector<size_t>
                              const IntensityGridParams& params, int min_count, const IntensityCalibration& calibration,
                              IntensityAccumulator& accumulator, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::intensity_matching));
-  const std::vector<char> near_obstacle = cells_near_obstacles(obstacles, params);
+  const std::vector<char> near_obstacle =
+      in_marked_cells(params, cells_near_obstacles(obstacles, params), points.xyz, ground);
   std::vector<Eigen::Vector2d> ground_xy;
   std::vector<double> intensities;
   ground_xy.reserve(ground.size());
   intensities.reserve(ground.size());
-  for (size_t i : ground) {
-    const std::optional<size_t> cell = intensity_cell_index(params, points.xyz[i].head<2>());
-    if (cell && near_obstacle[*cell]) continue;
+  for (size_t k = 0; k < ground.size(); ++k) {
+    if (near_obstacle[k]) continue;
+    const size_t i = ground[k];
     ground_xy.push_back(points.xyz[i].head<2>());
     intensities.push_back(calibration.correct(points.ring[i], points.intensity[i]));
   }
