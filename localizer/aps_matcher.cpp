@@ -242,12 +242,45 @@ IntensityGridBuilder::IntensityGridBuilder(const Pose2d& pose, const IntensityGr
   cells_.assign(size_t(params.width_cells) * size_t(params.height_cells), Sums{});
 }
 
+namespace {
+
+// intensity_cell_index's constants, read once for a loop over many points.
+struct CellIndexer {
+  Eigen::Array2d half_extent;  // the grid's half size in cells: its columns and rows from 0 at its edge
+  double cols, rows, cell_m;
+  size_t width;
+
+  explicit CellIndexer(const IntensityGridParams& p)
+      : half_extent(0.5 * p.width_cells, 0.5 * p.height_cells),
+        cols(p.width_cells),
+        rows(p.height_cells),
+        cell_m(p.cell_m),
+        width(size_t(p.width_cells)) {}
+
+  // x and y are divided as one pair: one vector division, each lane rounded as the scalar one is.
+  std::optional<size_t> operator()(const Eigen::Vector2d& point_vehicle) const {
+    const Eigen::Array2d q = point_vehicle.array() / cell_m + half_extent;
+    // `!(a >= 0 && a < n)` also refuses a NaN.
+    if (!(q.x() >= 0 && q.x() < cols && q.y() >= 0 && q.y() < rows)) return std::nullopt;
+    return size_t(q.y()) * width + size_t(q.x());  // floor: both are >= 0
+  }
+};
+
+}  // namespace
+
 std::optional<size_t> intensity_cell_index(const IntensityGridParams& params, const Eigen::Vector2d& point_vehicle) {
-  // Columns and rows from 0 at the grid's edge; `!(a >= 0 && a < n)` also refuses a NaN.
-  const double col = point_vehicle.x() / params.cell_m + 0.5 * params.width_cells;
-  const double row = point_vehicle.y() / params.cell_m + 0.5 * params.height_cells;
-  if (!(col >= 0 && col < params.width_cells && row >= 0 && row < params.height_cells)) return std::nullopt;
-  return size_t(row) * size_t(params.width_cells) + size_t(col);  // floor: both are >= 0
+  return CellIndexer(params)(point_vehicle);
+}
+
+std::vector<char> in_marked_cells(const IntensityGridParams& params, const std::vector<char>& marked,
+                                  const std::vector<Eigen::Vector3d>& points, const std::vector<size_t>& indices) {
+  const CellIndexer cell_index(params);
+  std::vector<char> out(indices.size(), 0);
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const std::optional<size_t> cell = cell_index(points[indices[k]].head<2>());
+    out[k] = cell && marked[*cell];
+  }
+  return out;
 }
 
 std::vector<char> cells_near_obstacles(const std::vector<Eigen::Vector2d>& obstacles, const IntensityGridParams& p) {
@@ -332,7 +365,18 @@ void IntensityGridBuilder::add(const std::vector<Eigen::Vector2d>& points_vehicl
   if (points_vehicle.size() != intensities.size())
     throw std::invalid_argument("IntensityGridBuilder::add: " + std::to_string(points_vehicle.size()) + " points but " +
                                 std::to_string(intensities.size()) + " intensities");
-  for (size_t i = 0; i < points_vehicle.size(); ++i) add(points_vehicle[i], intensities[i]);
+  // add() point by point, with the grid's constants read once (a scan's frames are ~10^5 points).
+  const CellIndexer cell_index(params_);
+  for (size_t i = 0; i < points_vehicle.size(); ++i) {
+    const double intensity = intensities[i];
+    if (!std::isfinite(intensity)) continue;
+    const std::optional<size_t> cell = cell_index(points_vehicle[i]);
+    if (!cell) continue;
+    Sums& c = cells_[*cell];
+    ++c.count;
+    c.sum += intensity;
+    c.sum_sq += intensity * intensity;
+  }
 }
 
 long IntensityGridBuilder::cells_with_more_than(uint32_t points) const {

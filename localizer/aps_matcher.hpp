@@ -69,6 +69,12 @@ struct IntensityGrid {
 // grid or not finite.
 std::optional<size_t> intensity_cell_index(const IntensityGridParams& params, const Eigen::Vector2d& point_vehicle);
 
+// For each of points[indices] (vehicle frame; z is ignored), in order, whether its cell of S is marked
+// (1) in `marked` (row-major, one entry per cell of S, as cells_near_obstacles gives): what
+// intensity_cell_index would say for each, for a whole scan at once. Points off the grid are not (0).
+std::vector<char> in_marked_cells(const IntensityGridParams& params, const std::vector<char>& marked,
+                                  const std::vector<Eigen::Vector3d>& points, const std::vector<size_t>& indices);
+
 // Which cells of S (row-major, 1 = yes) have their centre within params.obstacle_distance of an obstacle
 // point (vehicle frame, x-y); all 0 when it is 0.
 std::vector<char> cells_near_obstacles(const std::vector<Eigen::Vector2d>& obstacles_vehicle,

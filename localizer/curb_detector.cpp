@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace lidarloop {
 
@@ -26,7 +27,10 @@ constexpr double kRoundingSlack = 1e-9, kRoundingFloor = 1e-12;  // -, m^2
 // The scan's ground-looking points grouped by ring, ring after ring, each in firing (azimuth) order.
 // The scan interleaves the rings, so walking one ring in place would stride across all the others.
 struct RingPoints {
-  std::vector<double> x, y, z, range;            // range: horizontal distance from the vehicle
+  // range: horizontal distance from the vehicle. Arrays left uninitialised (new double[n], not a
+  // vector): every place a ring's range covers is written, the rest never read, and zeroing four
+  // scan-sized arrays first was a few percent of the detector.
+  std::unique_ptr<double[]> x, y, z, range;
   std::array<size_t, kMaxRings> begin{}, end{};  // ring r is [begin[r], end[r])
 };
 
@@ -41,7 +45,7 @@ RingPoints group_by_ring(const std::vector<Eigen::Vector3d>& points, const std::
   for (size_t i = 0; i < n; ++i) ++count[std::min<size_t>(rings[i], kDiscard)];
   for (size_t r = 1; r <= kDiscard; ++r) next[r] = next[r - 1] + count[r - 1];
   RingPoints g;
-  for (auto* v : {&g.x, &g.y, &g.z, &g.range}) v->resize(next[kDiscard] + 1);
+  for (auto* v : {&g.x, &g.y, &g.z, &g.range}) v->reset(new double[next[kDiscard] + 1]);
   std::copy_n(next.begin(), kMaxRings, g.begin.begin());
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d& q = points[i];
@@ -74,8 +78,8 @@ struct Ring {
   void load(const RingPoints& g, int ring) {
     const size_t b = g.begin[size_t(ring)];
     n = g.end[size_t(ring)] - b;
-    x = g.x.data() + b, y = g.y.data() + b, z = g.z.data() + b;
-    const double* range = g.range.data() + b;
+    x = g.x.get() + b, y = g.y.get() + b, z = g.z.get() + b;
+    const double* range = g.range.get() + b;
     s.resize(n + kLookahead);
     segment.resize(n + 1);
     z_sum.resize(n + 1);
@@ -235,11 +239,9 @@ double half_median_slope(const Ring& r, size_t a, size_t b, std::vector<double>&
   return run > 0 ? (median_z(m + 1, b) - median_z(a, m)) / run : 0.0;
 }
 
-// Height statistics of ring points [a, b] (either order): median (robust to a stray return), the
-// spread about it, and the tilt. A flat stretch may tilt (a crowned road, a sidewalk's cross-fall, the
-// flare beside a curb ramp); the rise is read where each stretch meets the step, so a slope that runs
-// on through road and sidewalk is not taken for a curb.
-Stretch stretch(const Ring& r, size_t a, size_t b, std::vector<double>& scratch) {
+// Height statistics of ring points [a, b] (either order): median (robust to a stray return) and the
+// spread about it. The tilt is left for tilt(): a stretch too rough to be flat needs none.
+Stretch level_stretch(const Ring& r, size_t a, size_t b, std::vector<double>& scratch) {
   if (a > b) std::swap(a, b);
   scratch.assign(r.z + a, r.z + b + 1);
   std::nth_element(scratch.begin(), scratch.begin() + long(scratch.size() / 2), scratch.end());
@@ -247,7 +249,16 @@ Stretch stretch(const Ring& r, size_t a, size_t b, std::vector<double>& scratch)
   double sum2 = 0;
   for (double v : scratch) sum2 += (v - median) * (v - median);
   const double sigma = std::sqrt(sum2 / double(scratch.size()));
-  return {median, sigma, half_median_slope(r, a, b, scratch), (r.s[a] + r.s[b]) / 2};
+  return {median, sigma, 0.0, 0.0};
+}
+
+// The tilt of the stretch of ring points [a, b] (either order). A flat stretch may tilt (a crowned
+// road, a sidewalk's cross-fall, the flare beside a curb ramp); the rise is read where each stretch
+// meets the step, so a slope that runs on through road and sidewalk is not taken for a curb.
+void tilt(const Ring& r, size_t a, size_t b, Stretch& stretch, std::vector<double>& scratch) {
+  if (a > b) std::swap(a, b);
+  stretch.slope = half_median_slope(r, a, b, scratch);
+  stretch.mid_s = (r.s[a] + r.s[b]) / 2;
 }
 
 }  // namespace
@@ -283,12 +294,17 @@ std::vector<Eigen::Vector2d> detect_curbs(const std::vector<Eigen::Vector3d>& po
         if (surely_rougher_than(ring, size_t(before), i, p.max_flat_roughness) ||
             surely_rougher_than(ring, size_t(top), size_t(after), p.max_flat_roughness))
           continue;
-        // Road before i, sidewalk after the rise: both flat, the sidewalk a curb's height higher.
-        const Stretch road = stretch(ring, size_t(before), i, scratch);
-        const Stretch walkway = stretch(ring, size_t(top), size_t(after), scratch);
+        // Road before i, sidewalk after the rise: both flat, the sidewalk a curb's height higher. The
+        // flatness first: it needs no tilt, and the tests are all pass-or-skip, so their order does
+        // not change what is found.
+        Stretch road = level_stretch(ring, size_t(before), i, scratch);
+        if (road.sigma_z > p.max_flat_roughness) continue;
+        Stretch walkway = level_stretch(ring, size_t(top), size_t(after), scratch);
+        if (walkway.sigma_z > p.max_flat_roughness) continue;
+        tilt(ring, size_t(before), i, road, scratch);
+        tilt(ring, size_t(top), size_t(after), walkway, scratch);
         const double rise = walkway.height_at(ring.s[size_t(top)]) - road.height_at(ring.s[i]);
         if (rise < p.min_height || rise > p.max_height) continue;
-        if (road.sigma_z > p.max_flat_roughness || walkway.sigma_z > p.max_flat_roughness) continue;
         // The foot of the rise: the last point still at road height.
         size_t foot = i;
         for (long k = long(i) + d.dir; k != top; k += d.dir)

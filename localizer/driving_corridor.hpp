@@ -41,6 +41,9 @@ struct DrivingCorridor {
   // True if the vehicle-frame point lies in a corridor cell. Points outside the grid are not in the
   // corridor: the grid is all the corridor we know of.
   bool contains(const Eigen::Vector2d& p_vehicle) const;
+  // The indices of the points (vehicle frame; z is ignored) that contains() accepts, in order: a whole
+  // scan at once, without a call per point (the corridor stage tests every point of the scan).
+  std::vector<size_t> inside(const std::vector<Eigen::Vector3d>& points_vehicle) const;
 };
 
 // World (local map frame, x east y north) -> vehicle frame (x forward, y left) for `pose`.

@@ -84,10 +84,9 @@ void check_geometry(const IntensityMapHeader& h, const char* who) {
                                 std::to_string(kMaxTileCells) + "]");
 }
 
-// Index of the global cell containing `coord`, floor division (so -0.1 m is cell -1), if the tile index
-// it falls in fits an int.
-std::optional<int64_t> global_cell(double coord, double resolution, int tile_cells) {
-  const double q = coord / resolution;
+// Index of the global cell containing a coordinate, from q = coordinate / resolution: floor division (so
+// -0.1 m is cell -1), if the tile index it falls in fits an int.
+std::optional<int64_t> global_cell(double q, int tile_cells) {
   if (!std::isfinite(q)) return std::nullopt;
   // A point a few ulps past a boundary is in the cell that starts there already; one a few ulps short of
   // it moves up into it. `next - q` is exact (Sterbenz) wherever the comparison can hold, so this is
@@ -103,8 +102,10 @@ std::optional<int64_t> global_cell(double coord, double resolution, int tile_cel
 }
 
 std::optional<CellIndex> try_cell_index(const IntensityMapHeader& h, const Eigen::Vector2d& xy) {
-  const auto gx = global_cell(xy.x(), h.resolution_m, h.tile_cells);
-  const auto gy = global_cell(xy.y(), h.resolution_m, h.tile_cells);
+  // x and y divided as one pair: one vector division, each lane rounded as the scalar one is.
+  const Eigen::Array2d q = xy.array() / h.resolution_m;
+  const auto gx = global_cell(q.x(), h.tile_cells);
+  const auto gy = global_cell(q.y(), h.tile_cells);
   if (!gx || !gy) return std::nullopt;
   const int64_t n = h.tile_cells;
   const int64_t tx = floor_div(*gx, n), ty = floor_div(*gy, n);

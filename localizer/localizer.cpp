@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include <Eigen/Dense>
 
@@ -57,8 +58,12 @@ std::vector<size_t> corridor_points(const ScanPoints& points, const CurbLayer& c
   const bool have_corridor = !corridor.mask.empty();
   if (!have_corridor) e.health |= kNoCorridor;
   std::vector<size_t> inside;
-  for (size_t i = 0; i < points.size(); ++i)
-    if (!have_corridor || corridor.contains(points.xyz[i].head<2>())) inside.push_back(i);
+  if (have_corridor) {
+    inside = corridor.inside(points.xyz);
+  } else {
+    inside.resize(points.size());
+    std::iota(inside.begin(), inside.end(), size_t{0});
+  }
   e.corridor_points = inside.size();
   return inside;
 }
@@ -105,14 +110,15 @@ IntensityGrid intensity_grid(const ScanPoints& points, const std::vector<size_t>
                              const IntensityGridParams& params, int min_count, const IntensityCalibration& calibration,
                              IntensityAccumulator& accumulator, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::intensity_matching));
-  const std::vector<char> near_obstacle = cells_near_obstacles(obstacles, params);
+  const std::vector<char> near_obstacle =
+      in_marked_cells(params, cells_near_obstacles(obstacles, params), points.xyz, ground);
   std::vector<Eigen::Vector2d> ground_xy;
   std::vector<double> intensities;
   ground_xy.reserve(ground.size());
   intensities.reserve(ground.size());
-  for (size_t i : ground) {
-    const std::optional<size_t> cell = intensity_cell_index(params, points.xyz[i].head<2>());
-    if (cell && near_obstacle[*cell]) continue;
+  for (size_t k = 0; k < ground.size(); ++k) {
+    if (near_obstacle[k]) continue;
+    const size_t i = ground[k];
     ground_xy.push_back(points.xyz[i].head<2>());
     intensities.push_back(calibration.correct(points.ring[i], points.intensity[i]));
   }

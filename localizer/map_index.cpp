@@ -2,14 +2,30 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 
 #include "common/points_kd_tree.hpp"
 
 namespace lidarloop {
 
-struct MapIndex::Tree : PointsKdTree {
-  using PointsKdTree::PointsKdTree;
+// The KD-tree, built by the first question that needs it: nearest_within answers from the buckets up
+// to kMaxRings bucket sizes, which covers the gates the curb matchers ask, so most indexes (one a scan)
+// are never asked and never pay for the tree, the larger part of building one. Questions may come from
+// several threads at once (probabilistic_icp), hence the once_flag.
+struct MapIndex::Tree {
+  std::once_flag built;
+  std::optional<PointsKdTree> kd;
+
+  const PointsKdTree& get(const std::vector<Eigen::Vector2d>* points) {
+    std::call_once(built, [&] { kd.emplace(points); });
+    return *kd;
+  }
+  // After the points move: re-aim a tree already built (one built later reads them where they are).
+  void points_moved(const std::vector<Eigen::Vector2d>* points) {
+    if (kd) kd->adaptor.points = points;
+  }
 };
 
 namespace {
@@ -28,7 +44,7 @@ MapIndex::MapIndex(std::vector<Eigen::Vector2d> points, double bucket_m, Queries
     if (!p.allFinite()) throw std::invalid_argument("MapIndex: map points must be finite");
   // nanoflann cannot build over zero points; an empty map answers every query with "nothing".
   if (points_.empty()) return;
-  if (queries == Queries::any) tree_ = std::make_unique<Tree>(&points_);
+  if (queries == Queries::any) tree_ = std::make_unique<Tree>();  // built on demand
 
   Buckets& b = buckets_;
   Eigen::Vector2d lo = points_[0], hi = points_[0];
@@ -64,13 +80,13 @@ MapIndex::~MapIndex() = default;
 // The tree reads the points through a pointer to the member vector: re-aim it after a move.
 MapIndex::MapIndex(MapIndex&& other) noexcept
     : points_(std::move(other.points_)), tree_(std::move(other.tree_)), buckets_(std::move(other.buckets_)) {
-  if (tree_) tree_->adaptor.points = &points_;
+  if (tree_) tree_->points_moved(&points_);
 }
 MapIndex& MapIndex::operator=(MapIndex&& other) noexcept {
   points_ = std::move(other.points_);
   tree_ = std::move(other.tree_);
   buckets_ = std::move(other.buckets_);
-  if (tree_) tree_->adaptor.points = &points_;
+  if (tree_) tree_->points_moved(&points_);
   return *this;
 }
 
@@ -80,7 +96,7 @@ std::pair<size_t, double> MapIndex::nearest(const Eigen::Vector2d& p) const {
   uint32_t index = 0;
   double squared = 0;
   const double query[2] = {p.x(), p.y()};
-  tree_->tree.knnSearch(query, 1, &index, &squared);
+  tree_->get(&points_).tree.knnSearch(query, 1, &index, &squared);
   return {size_t(index), std::sqrt(squared)};
 }
 
@@ -93,7 +109,10 @@ std::pair<size_t, double> MapIndex::nearest_within(const Eigen::Vector2d& p, dou
     const auto found = nearest(p);
     return found.second <= radius ? found : none;
   }
-  const double fc = std::floor((p.x() - b.origin.x()) / b.size), fr = std::floor((p.y() - b.origin.y()) / b.size);
+  // The query's bucket, x and y divided as one pair (one vector division, each lane rounded as the
+  // scalar one is).
+  const Eigen::Array2d f = ((p - b.origin).array() / b.size).floor();
+  const double fc = f.x(), fr = f.y();
   double best_squared = radius * radius;
   size_t best = SIZE_MAX;
   // Buckets r0..r1 x c0..c1, clamped to the grid in double first (so a query far off the map neither

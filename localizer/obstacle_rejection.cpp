@@ -11,6 +11,15 @@ namespace {
 
 bool finite(const Eigen::Vector3d& p) { return p.allFinite(); }
 
+// The length of the plane's normal (a0, a1, -1): height_above_plane divides by it.
+double normal_length(const Plane& plane) { return std::sqrt(plane.a0 * plane.a0 + plane.a1 * plane.a1 + 1.0); }
+
+// height_above_plane with the normal's length given: loops over a scan's points take the square root
+// once, not once a point.
+double height_above(const Plane& plane, double normal, const Eigen::Vector3d& p) {
+  return (p.z() - plane.a0 * p.x() - plane.a1 * p.y() - plane.a2) / normal;
+}
+
 // Beyond this many cells the cells grow instead: a caller may pass points spread over kilometres.
 constexpr double kMaxGroundCells = 1 << 20;
 
@@ -48,8 +57,9 @@ std::optional<Plane> fit_ground(const std::vector<Eigen::Vector3d>& points, cons
   if (!first) return fit_ground_plane(points, params.ground_fraction);
   std::vector<Eigen::Vector3d> near;
   near.reserve(points.size());
-  for (const auto& p : points)
-    if (distance_to_plane(*first, p) <= params.ground_refit_distance) near.push_back(p);
+  const double normal = normal_length(*first);
+  for (const auto& p : points)  // Eq. 3's distance_to_plane
+    if (std::abs(height_above(*first, normal, p)) <= params.ground_refit_distance) near.push_back(p);
   const std::optional<Plane> refit = fit_ground_plane(std::move(near), 1.0);
   return refit ? refit : first;
 }
@@ -100,13 +110,13 @@ std::optional<Plane> fit_ground_plane(std::vector<Eigen::Vector3d> points, doubl
 }
 
 double height_above_plane(const Plane& plane, const Eigen::Vector3d& p) {
-  return (p.z() - plane.a0 * p.x() - plane.a1 * p.y() - plane.a2) /
-         std::sqrt(plane.a0 * plane.a0 + plane.a1 * plane.a1 + 1.0);
+  return height_above(plane, normal_length(plane), p);
 }
 
 std::vector<Eigen::Vector3d> level_to_plane(const std::vector<Eigen::Vector3d>& points, const Plane& plane) {
   std::vector<Eigen::Vector3d> out(points);
-  for (Eigen::Vector3d& p : out) p.z() = height_above_plane(plane, p);
+  const double normal = normal_length(plane);
+  for (Eigen::Vector3d& p : out) p.z() = height_above(plane, normal, p);
   return out;
 }
 
@@ -136,9 +146,10 @@ ObstacleSplit reject_obstacles(const std::vector<Eigen::Vector3d>& corridor_poin
   out.plane_ok = true;
   out.ground.reserve(pts.size());
   out.ground_index.reserve(pts.size());
+  const double normal = normal_length(*plane);
   for (size_t k = 0; k < pts.size(); ++k) {
     // Eq. 3 with the sign kept: d_i > d_sigma and above the plane (see the header for why).
-    if (height_above_plane(*plane, pts[k]) > params.obstacle_distance) {
+    if (height_above(*plane, normal, pts[k]) > params.obstacle_distance) {
       out.obstacles.push_back(pts[k]);
       out.obstacle_index.push_back(index[k]);
     } else {
