@@ -8,8 +8,9 @@
 //
 // Every parameter is in GicpParams (YAML `localizer: gicp:`), with why it has its default.
 //
-// Open3D's headers are heavy (seconds of compile per file that includes them): only gicp_matcher.cpp
-// includes them; the target below hides its Open3D cloud behind a pointer.
+// Open3D's headers are heavy (seconds of compile per file that includes them) and its libraries slow
+// every process's start: only gicp_open3d.cpp includes them, in a module loaded on first use
+// (gicp_backend.hpp); the target below hides its cloud behind a pointer.
 //
 // Determinism: Open3D's registration sums over correspondences in OpenMP reductions and gathers them
 // under a critical section, so its result depends on the thread count and on the threads' order.
