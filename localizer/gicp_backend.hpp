@@ -23,8 +23,8 @@ struct GicpBackend {
   void (*destroy)(GicpCloud* cloud);
   size_t (*size)(const GicpCloud* cloud);  // 0 for none
   // gicp_match's contract, against `target` (which may be null: no map).
-  GicpResult (*match)(const std::vector<Eigen::Vector3d>& scan, const Eigen::Isometry3d& prior,
-                      const GicpCloud* target, const GicpParams& p, double max_correspondence_m);
+  GicpResult (*match)(const std::vector<Eigen::Vector3d>& scan, const Eigen::Isometry3d& prior, const GicpCloud* target,
+                      const GicpParams& p, double max_correspondence_m);
 };
 
 // The module's one entry point.

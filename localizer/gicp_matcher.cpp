@@ -70,9 +70,9 @@ bool GicpTarget::covers(const Eigen::Vector2d& centre, const GicpParams& p) cons
 void GicpTarget::build(const std::vector<Eigen::Vector3d>& map_points, const Eigen::Vector2d& centre,
                        const GicpParams& p) {
   const bool reuse = cloud_ && centre_;
-  auto cloud = std::make_unique<Cloud>(backend().build(map_points, reuse ? cloud_->cloud : nullptr,
-                                                       reuse ? &*centre_ : nullptr,
-                                                       radius(p) - p.covariance_reuse_margin_m, p));
+  auto cloud =
+      std::make_unique<Cloud>(backend().build(map_points, reuse ? cloud_->cloud : nullptr, reuse ? &*centre_ : nullptr,
+                                              radius(p) - p.covariance_reuse_margin_m, p));
   cloud_ = std::move(cloud);
   centre_ = centre;
   ++builds_;
