@@ -365,18 +365,7 @@ void IntensityGridBuilder::add(const std::vector<Eigen::Vector2d>& points_vehicl
   if (points_vehicle.size() != intensities.size())
     throw std::invalid_argument("IntensityGridBuilder::add: " + std::to_string(points_vehicle.size()) + " points but " +
                                 std::to_string(intensities.size()) + " intensities");
-  // add() point by point, with the grid's constants read once (a scan's frames are ~10^5 points).
-  const CellIndexer cell_index(params_);
-  for (size_t i = 0; i < points_vehicle.size(); ++i) {
-    const double intensity = intensities[i];
-    if (!std::isfinite(intensity)) continue;
-    const std::optional<size_t> cell = cell_index(points_vehicle[i]);
-    if (!cell) continue;
-    Sums& c = cells_[*cell];
-    ++c.count;
-    c.sum += intensity;
-    c.sum_sq += intensity * intensity;
-  }
+  for (size_t i = 0; i < points_vehicle.size(); ++i) add(points_vehicle[i], intensities[i]);
 }
 
 long IntensityGridBuilder::cells_with_more_than(uint32_t points) const {

@@ -22,8 +22,7 @@ Eigen::Vector2d vehicle_to_world(const Pose2d& pose, const Eigen::Vector2d& p) {
 
 namespace {
 
-// Cell of a vehicle-frame point, shared by the projection (Eq. 1) and the queries so both agree
-// (DrivingCorridor::inside repeats its arithmetic for a whole scan).
+// Cell of a vehicle-frame point, shared by the projection (Eq. 1) and the queries so both agree.
 std::optional<cv::Point> cell_of(const CorridorParams& params, const Eigen::Vector2d& p) {
   if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || params.cell_m <= 0) return std::nullopt;
   // floor, not truncation, so the cells either side of 0 are not merged into one double-size cell.
@@ -49,16 +48,9 @@ std::vector<size_t> DrivingCorridor::inside(const std::vector<Eigen::Vector3d>& 
   std::vector<size_t> out;
   if (mask.empty() || !(params.cell_m > 0)) return out;
   out.reserve(points_vehicle.size());
-  // cell_of's arithmetic, with the grid's constants read once and x and -y divided as one pair (one
-  // vector division, each lane rounded as the scalar one is). A point off the grid or not finite
-  // fails the bounds test (NaN fails every comparison, an infinity the bounds), as cell_of refuses it.
-  const Eigen::Array2d centre(params.width_cells / 2, params.height_cells / 2);
-  const double cols = params.width_cells, rows = params.height_cells, cell_m = params.cell_m;
-  for (size_t i = 0; i < points_vehicle.size(); ++i) {
-    const Eigen::Array2d q = (Eigen::Array2d(points_vehicle[i].x(), -points_vehicle[i].y()) / cell_m).floor() + centre;
-    if (!(q.x() >= 0 && q.y() >= 0 && q.x() < cols && q.y() < rows)) continue;
-    if (mask.at<std::uint8_t>(static_cast<int>(q.y()), static_cast<int>(q.x())) != 0) out.push_back(i);
-  }
+  for (size_t i = 0; i < points_vehicle.size(); ++i)
+    if (const auto c = cell_of(params, points_vehicle[i].head<2>()); c && mask.at<std::uint8_t>(*c) != 0)
+      out.push_back(i);
   return out;
 }
 
