@@ -60,7 +60,7 @@ void record_log(const std::string& path, McapWriterOptions options) {
     for (int k = 0; k < kPointsPerScan; ++k)
       cloud.points.push_back({float(k), float(-k) * 0.5f, -1.9f, uint8_t(k * 7), uint16_t(k % 32), uint32_t(k * 1152)});
     log.write_scan(cloud);
-    log.write_velodyne_scan(seed_rotation(t));
+    log.write_velodyne_scan(seed_rotation(t), t);
     log.write_actors(t, {ros2::ActorState{"bus0", "bus", Pose2d{5.0 + i, 3.5, 0}}});
     // The last scan lost, so the seed holds both an infinite and a finite protection bound.
     LocalizerStatus status;

@@ -121,6 +121,16 @@ std::vector<ros2::VelodynePacket> hdl32e_data_packets(const Hdl32eRotation& rota
   return packets;
 }
 
+std::vector<Hdl32eBlock> hdl32e_blocks(const ros2::VelodyneScan& scan, const std::string& context) {
+  std::vector<Hdl32eBlock> blocks;
+  blocks.reserve(scan.packets.size() * kHdl32eBlocksPerPacket);
+  for (size_t i = 0; i < scan.packets.size(); ++i) {
+    const Hdl32eDataPacket p = decode_hdl32e_packet(scan.packets[i].data, context + ": packet " + std::to_string(i));
+    blocks.insert(blocks.end(), p.blocks.begin(), p.blocks.end());
+  }
+  return blocks;
+}
+
 uint8_t nmea_checksum(std::string_view sentence) {
   const size_t begin = sentence.find('$'), end = sentence.find('*');
   uint8_t sum = 0;

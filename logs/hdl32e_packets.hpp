@@ -60,10 +60,15 @@ Hdl32eDataPacket decode_hdl32e_packet(std::span<const uint8_t> bytes,
 // Microseconds past the top of the hour of a time in ns since the Unix epoch (the log's clock).
 uint32_t usec_past_hour(int64_t t_ns);
 
-// A revolution's blocks in packets of 12, each stamped with its first block's time. The last packet
-// is filled with empty blocks (no returns, the azimuth stepping on), so a scan's packets hold exactly
-// its returns: 2170 cycles at 10 Hz give 181 packets, as the ROS driver's ceil(1808 / 10) per scan.
+// A revolution's blocks in packets of 12, each stamped with its first block's time on the sensor's
+// clock (its timestamp bytes, which a driver with `gps_time` reads). The last packet is filled with
+// empty blocks (no returns, the azimuth stepping on), so a scan's packets hold exactly its returns:
+// 2170 cycles at 10 Hz give 181 packets, as the ROS driver's ceil(1808 / 10) per scan.
 std::vector<ros2::VelodynePacket> hdl32e_data_packets(const Hdl32eRotation& rotation);
+// What a driver reads back: the blocks of a scan's packets in order, the last packet's padding
+// included (it holds no returns). InputError "<context>: packet N: ..." for a packet that is not an
+// HDL-32E data packet.
+std::vector<Hdl32eBlock> hdl32e_blocks(const ros2::VelodyneScan& scan, const std::string& context);
 
 // "$GPRMC,hhmmss,A,ddmm.mmmmm,N,dddmm.mmmmm,E,knots,course,ddmmyy,,,A*hh\r\n" at UTC time t_ns (ns since
 // the Unix epoch); status V with empty position fields when `fix` has no fix. `speed_mps` gives the

@@ -19,6 +19,7 @@
 #include "logs/pcap_file.hpp"
 #include "logs/pcd_file.hpp"
 #include "logs/ros2_messages.hpp"
+#include "logs/scan_messages.hpp"
 #include "logs/tum_file.hpp"
 
 namespace lidarloop {
@@ -97,16 +98,19 @@ ExportResult export_tum(const std::string& log, const std::string& file, const s
   return {chosen, poses[chosen].size()};
 }
 
-ExportResult export_pcd(const std::string& log, const std::string& dir, const std::string& topic) {
-  const std::string chosen = topic.empty() ? log_topics::scan : topic;
+ExportResult export_pcd(const std::string& log, const std::string& dir, const Hdl32eCalibration& calibration,
+                        const std::string& topic) {
   McapReader reader(log);
   make_dir(dir);
   std::ofstream stamps = open_out(dir + "/timestamps.txt");
   size_t count = 0;
   std::vector<char> body;
+  std::string chosen = topic.empty() ? log_topics::scan : topic;
   for (McapMessage m; reader.next(m);) {
-    if (m.channel->topic != chosen || !has_type(m, "sensor_msgs/msg/PointCloud2")) continue;
-    const PointCloud cloud = ros2::decode_point_cloud(m.data, context(reader, m));
+    const std::optional<PointCloud> scan = scan_message(reader, m, calibration, topic);
+    if (!scan) continue;
+    chosen = m.channel->topic;
+    const PointCloud& cloud = *scan;
     const std::string h =
         binary_pcd_header({{"x"}, {"y"}, {"z"}, {"intensity"}, {"ring", 2, 'U'}, {"time"}}, cloud.points.size(),
                           "lidarloop scan, stamp " + std::to_string(cloud.stamp_ns) + " ns");
@@ -130,8 +134,9 @@ ExportResult export_pcd(const std::string& log, const std::string& dir, const st
   return {chosen, count};
 }
 
-ExportResult export_kitti(const std::string& log, const std::string& dir, const std::string& topic) {
-  const std::string chosen = topic.empty() ? log_topics::scan : topic;
+ExportResult export_kitti(const std::string& log, const std::string& dir, const Hdl32eCalibration& calibration,
+                          const std::string& topic) {
+  std::string chosen = topic.empty() ? log_topics::scan : topic;
   McapReader reader(log);
   const std::string velo = dir + "/velodyne_points", oxts = dir + "/oxts";
   make_dir(velo + "/data");
@@ -153,8 +158,9 @@ ExportResult export_kitti(const std::string& log, const std::string& dir, const 
   std::vector<char> body;
   for (McapMessage m; reader.next(m);) {
     const std::string& t = m.channel->topic;
-    if (t == chosen && has_type(m, "sensor_msgs/msg/PointCloud2")) {
-      const PointCloud cloud = ros2::decode_point_cloud(m.data, context(reader, m));
+    if (const std::optional<PointCloud> scan = scan_message(reader, m, calibration, topic)) {
+      chosen = t;
+      const PointCloud& cloud = *scan;
       body.clear();
       body.reserve(cloud.points.size() * 16);
       uint32_t last = 0;

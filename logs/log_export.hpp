@@ -10,6 +10,8 @@
 #include <cstddef>
 #include <string>
 
+#include "common/hdl32e_driver.hpp"
+
 namespace lidarloop {
 
 struct ExportResult {
@@ -20,8 +22,12 @@ struct ExportResult {
 // `topic`: a nav_msgs/msg/Odometry topic; empty picks the localizer's estimate if the log has one,
 // else the ground truth.
 ExportResult export_tum(const std::string& log, const std::string& file, const std::string& topic = "");
-ExportResult export_pcd(const std::string& log, const std::string& dir, const std::string& topic = "");
-ExportResult export_kitti(const std::string& log, const std::string& dir, const std::string& topic = "");
+// PCD and KITTI: the scans of logs/scan_messages.hpp, `calibration` decoding a packets-only log's
+// packets; `topic` as there (empty: the log's scans).
+ExportResult export_pcd(const std::string& log, const std::string& dir, const Hdl32eCalibration& calibration,
+                        const std::string& topic = "");
+ExportResult export_kitti(const std::string& log, const std::string& dir, const Hdl32eCalibration& calibration,
+                          const std::string& topic = "");
 // PCAP   the HDL-32E's UDP traffic as a capture (logs/pcap_file.hpp) VeloView or the ROS driver replay:
 //        every data packet of a velodyne_msgs/msg/VelodyneScan topic (default /velodyne_packets, logged
 //        by `--record FILE --packets`) to port 2368, and a position packet with a $GPRMC from the GPS

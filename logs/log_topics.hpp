@@ -3,7 +3,8 @@
 // between the recorder and whatever reads a log back (replay, export, info, other people's tools).
 //
 //   topic                 type                              frame_id -> child
-//   /lidar/points         sensor_msgs/msg/PointCloud2       lidar (layout in ros2_messages.hpp)
+//   /lidar/points         sensor_msgs/msg/PointCloud2       lidar (layout in ros2_messages.hpp; not in a
+//                                                           --packets-only log: scan_messages.hpp)
 //   /gps/fix              sensor_msgs/msg/NavSatFix         gps   (low-cost receiver)
 //   /gps/heading          lidarloop_msgs/msg/GnssHeading    gps
 //   /gps/rtk/fix          sensor_msgs/msg/NavSatFix         gps   (RTK-grade reference)
@@ -19,8 +20,8 @@
 //                                                           bounds; every scan: localizer_status.hpp)
 //   /tf                   tf2_msgs/msg/TFMessage            map -> base_link (truth), map -> base_link_estimate
 //   /tf_static            tf2_msgs/msg/TFMessage            base_link -> lidar (mount), base_link -> gps
-//   /velodyne_packets     velodyne_msgs/msg/VelodyneScan    lidar (with --packets: the scans' raw HDL-32E
-//                                                           packets, logs/hdl32e_packets.hpp)
+//   /velodyne_packets     velodyne_msgs/msg/VelodyneScan    lidar (with --packets or --packets-only: the
+//                                                           scans' raw HDL-32E packets, hdl32e_packets.hpp)
 //
 // Frames: map is the local transverse Mercator frame (x east, y north, z up); base_link is the
 // vehicle frame (x forward, y left, z up, origin at the rear axle centre on the ground); gps is the

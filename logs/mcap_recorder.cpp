@@ -109,9 +109,9 @@ void McapRecorder::write_scan(const PointCloud& cloud) {
   write(points, cloud.stamp_ns, scan_buffer_);
 }
 
-void McapRecorder::write_velodyne_scan(const Hdl32eRotation& rotation) {
+void McapRecorder::write_velodyne_scan(const Hdl32eRotation& rotation, int64_t stamp_ns) {
   static constexpr ChannelSpec spec{t::velodyne_packets, "velodyne_msgs/msg/VelodyneScan"};
-  ros2::VelodyneScan scan{rotation.start_ns, t::lidar_frame, hdl32e_data_packets(rotation)};
+  ros2::VelodyneScan scan{stamp_ns, t::lidar_frame, hdl32e_data_packets(rotation)};
   write(spec, scan.stamp_ns, ros2::encode_velodyne_scan(scan));
 }
 

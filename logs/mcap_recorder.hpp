@@ -45,8 +45,10 @@ class McapRecorder {
   void write_scan(const PointCloud& cloud);
   void write_actors(int64_t stamp_ns, const std::vector<ros2::ActorState>& actors);
   void write_curb_visibility(const CurbVisibility& visibility);
-  // A scan as the HDL-32E's data packets (logs/hdl32e_packets.hpp), stamped with its first packet.
-  void write_velodyne_scan(const Hdl32eRotation& rotation);
+  // A scan as the HDL-32E's data packets (logs/hdl32e_packets.hpp, each on the sensor's clock), the
+  // message stamped `stamp_ns` as its cloud is (by the host), so that a cloud decoded from it has the
+  // live cloud's stamp.
+  void write_velodyne_scan(const Hdl32eRotation& rotation, int64_t stamp_ns);
 
   // The localizer's answer to a scan: its status on /localizer/status (localizer_status.hpp), and
   // once it has a pose (`pose` set) /localizer/odometry (covariance of x, y, yaw) and /tf, all at the

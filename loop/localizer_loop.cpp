@@ -131,8 +131,8 @@ class PipelinedSink : public StreamSink {
     push(ScanMessage{cloud, sensor_pose});
     scan_outstanding_ = true;
   }
-  void on_lidar_rotation(const Hdl32eRotation& r) override {
-    if (also_) also_->on_lidar_rotation(r);  // the scan's packets, next to the scan
+  void on_lidar_rotation(const Hdl32eRotation& r, int64_t stamp_ns) override {
+    if (also_) also_->on_lidar_rotation(r, stamp_ns);  // the scan's packets, next to the scan
   }
 
   // Scan k's estimate (k counted from 0) once the localizers have made it, before it is handed out;
@@ -391,7 +391,7 @@ class SimulationTap : public StreamSink {
     if (on_scan_complete_) on_scan_complete_();
     next_.on_scan(cloud, sensor_pose);
   }
-  void on_lidar_rotation(const Hdl32eRotation& r) override { next_.on_lidar_rotation(r); }
+  void on_lidar_rotation(const Hdl32eRotation& r, int64_t stamp_ns) override { next_.on_lidar_rotation(r, stamp_ns); }
   void on_curb_visibility(const CurbVisibility& v) override {
     result_.curb_visibility.push_back(v);
     next_.on_curb_visibility(v);

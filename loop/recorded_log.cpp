@@ -3,6 +3,7 @@
 #include "common/input_error.hpp"
 #include "logs/log_topics.hpp"
 #include "logs/ros2_messages.hpp"
+#include "logs/scan_messages.hpp"
 #include "loop/run_recording.hpp"
 #include "sim/vehicle_model.hpp"
 #include "sim/world_assets.hpp"
@@ -72,13 +73,23 @@ RecordedLog read_recorded_log(const std::string& log) {
   return out;
 }
 
+Hdl32eCalibration recorded_calibration(const std::string& log) {
+  McapReader reader(log);
+  McapMessage first;
+  reader.next(first);  // the scenario is written before the first message
+  for (const auto& a : reader.attachments())
+    if (a.name == kScenarioAttachment) return recorded_run(reader, log).scenario.lidar.calibration();
+  return Hdl32eConfig{}.calibration();
+}
+
 std::optional<PointCloud> recorded_scan_before(const std::string& log, int64_t stamp_ns) {
+  const Hdl32eCalibration calibration = recorded_calibration(log);
   McapReader reader(log);
   std::optional<PointCloud> found;
   for (McapMessage message; reader.next(message);) {
-    if (message.channel->topic != topics::scan) continue;
-    PointCloud cloud = ros2::decode_point_cloud(message.data, log + " " + topics::scan);
-    if (found && cloud.stamp_ns > stamp_ns) break;  // the first scan, or the latest at or before
+    std::optional<PointCloud> cloud = scan_message(reader, message, calibration);
+    if (!cloud) continue;
+    if (found && cloud->stamp_ns > stamp_ns) break;  // the first scan, or the latest at or before
     found = std::move(cloud);
   }
   return found;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/curb_visibility.hpp"
+#include "common/hdl32e_driver.hpp"
 #include "common/point_cloud.hpp"
 #include "common/vehicle_messages.hpp"
 #include "logs/mcap/mcap_reader.hpp"
@@ -42,6 +43,11 @@ struct RecordedLog {
 };
 // InputError naming `log` when it has no ground truth to score against.
 RecordedLog read_recorded_log(const std::string& log);
+
+// The calibration of the sensor a log was recorded with, to decode its packets (logs/scan_messages.hpp):
+// its scenario's (`lidar:`), else, for a log lidarloop did not record, the stock HDL-32E's, which the
+// drivers ship.
+Hdl32eCalibration recorded_calibration(const std::string& log);
 
 // The log's last scan stamped at or before `stamp_ns` (the scan an estimate at that time was made
 // from, when a localizer stamps its pose at or after the scan's start), else its first scan; nullopt

@@ -68,13 +68,15 @@ void record_estimate(McapRecorder& log, const LocalizerEstimate& e) {
 }
 
 std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>& path, const Scenario& scenario,
-                                               const std::string& method, bool packets) {
-  if (packets && !path) throw InputError("--packets: needs --record FILE.mcap");
+                                               const std::string& method, ScanRecording scans) {
+  if (scans != ScanRecording::points && !path)
+    throw InputError(std::string(scans == ScanRecording::packets ? "--packets-only" : "--packets") +
+                     ": needs --record FILE.mcap");
   if (!path) return nullptr;
   if (path->empty()) throw InputError("--record: needs a file name");
   // The nominal extrinsics, as localizer_params_for gives the localizer (and an exec: program's metadata).
   auto recorder = std::make_unique<RecordingSink>(*path, scenario.lidar.mount(), scenario.gps.antenna_xyz);
-  recorder->record_packets(packets);
+  recorder->record_scans(scans);
   McapRecorder& log = recorder->log();
   log.add_attachment(kScenarioAttachment, "application/yaml", scenario.text);
   log.add_attachment(kVehicleAttachment, "application/yaml", vehicle_yaml(scenario.ego.vehicle));

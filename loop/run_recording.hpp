@@ -55,15 +55,21 @@ class TeeSink : public StreamSink {
     a_.on_curb_visibility(v);
     if (b_) b_->on_curb_visibility(v);
   }
-  void on_lidar_rotation(const Hdl32eRotation& r) override {
-    a_.on_lidar_rotation(r);
-    if (b_) b_->on_lidar_rotation(r);
+  void on_lidar_rotation(const Hdl32eRotation& r, int64_t stamp_ns) override {
+    a_.on_lidar_rotation(r, stamp_ns);
+    if (b_) b_->on_lidar_rotation(r, stamp_ns);
   }
 
  private:
   StreamSink& a_;
   StreamSink* b_;
 };
+
+// What a log keeps of each scan: the cloud a driver made of it (/lidar/points); that and the
+// HDL-32E's raw packets (/velodyne_packets, `--packets`); or the packets alone (`--packets-only`),
+// which is the sensor's own data rate: replay and export decode them as a driver does
+// (loop/recorded_scans.hpp), giving the live run's clouds to the bit.
+enum class ScanRecording { points, points_and_packets, packets };
 
 // The simulator's streams into an MCAP log (logs/ knows messages, not the simulator).
 class RecordingSink : public StreamSink {
@@ -75,20 +81,21 @@ class RecordingSink : public StreamSink {
   void on_gps(const GpsFix& f) override { log_.write_gps(f); }
   void on_rtk(const GpsFix& f) override { log_.write_rtk(f); }
   // The sensor pose is not logged separately: /tf (truth) and /tf_static (mount) give it.
-  void on_scan(const PointCloud& c, const Eigen::Isometry3d&) override { log_.write_scan(c); }
+  void on_scan(const PointCloud& c, const Eigen::Isometry3d&) override {
+    if (scans_ != ScanRecording::packets) log_.write_scan(c);
+  }
   void on_actors(int64_t stamp_ns, const std::vector<ActorSample>& actors) override;
   void on_curb_visibility(const CurbVisibility& v) override { log_.write_curb_visibility(v); }
-  // `--packets`: each scan also as the HDL-32E's raw packets (velodyne_msgs/msg/VelodyneScan).
-  void on_lidar_rotation(const Hdl32eRotation& r) override {
-    if (packets_) log_.write_velodyne_scan(r);
+  void on_lidar_rotation(const Hdl32eRotation& r, int64_t stamp_ns) override {
+    if (scans_ != ScanRecording::points) log_.write_velodyne_scan(r, stamp_ns);
   }
-  void record_packets(bool on) { packets_ = on; }
+  void record_scans(ScanRecording scans) { scans_ = scans; }
 
   McapRecorder& log() { return log_; }
 
  private:
   McapRecorder log_;
-  bool packets_ = false;
+  ScanRecording scans_ = ScanRecording::points;
 };
 
 // What /localizer/status says of an estimate (logs/localizer_status.hpp): not initialised is stale,
@@ -97,9 +104,9 @@ LocalizerStatus localizer_status(const LocalizerEstimate& estimate);
 // An estimate into the log: its status always, its pose once the localizer has one.
 void record_estimate(McapRecorder& log, const LocalizerEstimate& estimate);
 
-// Null when `path` is empty. `method` is the localizer's, empty for `simulate`. `packets`: record
-// the HDL-32E's packets too (InputError without a path).
+// Null when `path` is empty. `method` is the localizer's, empty for `simulate`. InputError for
+// `scans` other than points without a path.
 std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>& path, const Scenario& scenario,
-                                               const std::string& method, bool packets = false);
+                                               const std::string& method, ScanRecording scans = ScanRecording::points);
 
 }  // namespace lidarloop

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "common/units.hpp"
+
 namespace lidarloop {
 
 std::array<double, kHdl32eLasers> Hdl32eConfig::default_elevations() {
@@ -30,6 +32,19 @@ Eigen::Isometry3d Hdl32eConfig::mount() const {
            Eigen::AngleAxisd(mount_rpy_deg.y() * deg, Eigen::Vector3d::UnitY()) *
            Eigen::AngleAxisd(mount_rpy_deg.x() * deg, Eigen::Vector3d::UnitX()));
   return m;
+}
+
+Hdl32eCalibration Hdl32eConfig::calibration() const {
+  Hdl32eCalibration c;
+  for (size_t slot = 0; slot < size_t(kHdl32eLasers); ++slot) {
+    const double elevation = elevation_deg[size_t(firing_order[slot])] * kDeg;
+    c.ring[slot] = uint16_t(firing_order[slot]);
+    c.cos_elevation[slot] = std::cos(elevation);
+    c.sin_elevation[slot] = std::sin(elevation);
+  }
+  c.firing_period_ns = firing_period_ns;
+  c.cycle_period_ns = cycle_period_ns();
+  return c;
 }
 
 Hdl32eConfig hdl32e_config_for(Realism realism) {

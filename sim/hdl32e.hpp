@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/hdl32e_driver.hpp"
 #include "common/yaml_reader.hpp"
 #include "sim/realism.hpp"
 
@@ -98,6 +99,8 @@ struct Hdl32eConfig {
     return 360.0 * rotation_hz * double(firing_period_ns) * 1e-9 * (kHdl32eLasers - 1) / 2.0;
   }
   Eigen::Isometry3d mount() const;
+  // What a driver needs to decode this unit's blocks (its vertical angles and firing timing).
+  Hdl32eCalibration calibration() const;
 
   static std::array<double, kHdl32eLasers> default_elevations();
   static std::array<int, kHdl32eLasers> default_firing_order();

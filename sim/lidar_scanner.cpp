@@ -42,7 +42,7 @@ PoseAt constant_twist(const Eigen::Isometry3d& start, int64_t t0_ns, double v, d
 }
 
 LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& materials, const WeatherConfig& weather)
-    : config_(config), weather_(weather), returns_(config), mount_(config.mount()) {
+    : config_(config), weather_(weather), returns_(config), mount_(config.mount()), calibration_(config.calibration()) {
   // The mount is the frame the driver's points are in: a calibration fits the decoded clouds, so it
   // absorbs the mean lag between a cycle's azimuth reading and its firings. The head itself sits that
   // much counter-clockwise of it, and a cycle's rays straddle its reported azimuth, +-0.064 deg at 10 Hz.
@@ -58,8 +58,6 @@ LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& mate
   const double yaw_rate = -2 * M_PI * config.rotation_hz;
   for (int slot = 0; slot < kHdl32eLasers; ++slot) {
     const double elevation = config.elevation_deg[config.firing_order[slot]] * kDeg;
-    slot_cos_elevation_[slot] = std::cos(elevation);
-    slot_sin_elevation_[slot] = std::sin(elevation);
     const double yaw = yaw_rate * double(slot * config.firing_period_ns) * 1e-9;
     slot_direction_[slot] = Eigen::Vector3f(float(std::cos(elevation) * std::cos(yaw)),
                                             float(std::cos(elevation) * std::sin(yaw)), float(std::sin(elevation)));
@@ -73,7 +71,6 @@ LidarScanner::LidarScanner(const Hdl32eConfig& config, const MaterialTable& mate
     const double yaw = config.scan_start_yaw_deg * kDeg + yaw_rate * double(config.firing_time_ns(cycle, 0)) * 1e-9;
     cycle_yaw_.emplace_back(float(std::cos(yaw)), float(std::sin(yaw)));
     cycle_azimuth_.push_back(hdl32e_azimuth(yaw));
-    cycle_rotation_.push_back(hdl32e_rotation(cycle_azimuth_.back()));
   }
 }
 
@@ -245,30 +242,23 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
   // What the sensor sends (one block per cycle: the cycle's azimuth, 2 mm distance units, integer
   // intensities), and the points a driver makes of it: every laser of a block at the block's
   // azimuth, though its ray left up to 31 slots (0.13 deg at 10 Hz) later.
-  PointCloud cloud;
-  cloud.stamp_ns = stamp_ns;
-  cloud.points.reserve(firings);
-  if (wire) *wire = {stamp_ns, config_.cycle_period_ns(), std::vector<Hdl32eBlock>(size_t(cycles))};
+  Hdl32eRotation own;
+  Hdl32eRotation& sent = wire ? *wire : own;
+  sent = {stamp_ns, config_.cycle_period_ns(), std::vector<Hdl32eBlock>(size_t(cycles))};
   for (int cycle = 0; cycle < cycles; ++cycle) {
-    const uint16_t azimuth = cycle_azimuth_[size_t(cycle)];
-    if (wire) wire->blocks[size_t(cycle)].azimuth = azimuth;
+    Hdl32eBlock& block = sent.blocks[size_t(cycle)];
+    block.azimuth = cycle_azimuth_[size_t(cycle)];
     for (int slot = 0; slot < kHdl32eLasers; ++slot) {
       const size_t i = size_t(cycle) * kHdl32eLasers + size_t(slot);
       // The range limits hold for what the sensor reports, a mixed range included.
       if (!valid[i] || ranges[i] < config_.min_range_m || ranges[i] > config_.max_range_m) continue;
       const long units = std::lround(double(ranges[i]) / kHdl32eDistanceUnitM);
       if (units <= 0 || units > std::numeric_limits<uint16_t>::max()) continue;  // not on the wire
-      const Hdl32ePoint p = hdl32e_point(cycle_rotation_[size_t(cycle)], slot_cos_elevation_[size_t(slot)],
-                                         slot_sin_elevation_[size_t(slot)], uint16_t(units));
-      cloud.points.push_back({p.x, p.y, p.z, intensities[i], uint16_t(config_.firing_order[size_t(slot)]),
-                              uint32_t(config_.firing_time_ns(cycle, slot))});
-      if (wire) {
-        wire->blocks[size_t(cycle)].distance[size_t(slot)] = uint16_t(units);
-        wire->blocks[size_t(cycle)].intensity[size_t(slot)] = intensities[i];
-      }
+      block.distance[size_t(slot)] = uint16_t(units);
+      block.intensity[size_t(slot)] = intensities[i];
     }
   }
-  return cloud;
+  return hdl32e_cloud(calibration_, stamp_ns, sent.blocks);
 }
 
 void LidarScanner::mix_depth_edges(const std::vector<float>& surface_range, const std::vector<float>& surface_signal,

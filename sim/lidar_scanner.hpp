@@ -52,7 +52,8 @@ class LidarScanner {
   const Hdl32eConfig& config() const { return config_; }
   const WeatherConfig& weather() const { return weather_; }
 
-  // `wire`, when given, receives the scan's blocks as the sensor sends them, starting at stamp_ns.
+  // The cloud is what a driver decodes from the scan's blocks (hdl32e_cloud). `wire`, when given,
+  // receives those blocks as the sensor sends them, starting at stamp_ns.
   // Only the lasers whose bit (by laser id, 0-31) is set in `lasers` are cast; the others return
   // nothing. The random draws are by firing, so the lasers cast give the same returns either way.
   PointCloud scan(RayScene& scene, const PoseAt& vehicle_pose, int64_t stamp_ns, uint64_t seed,
@@ -90,13 +91,12 @@ class LidarScanner {
   std::vector<uint8_t> carriageway_;  // per material: road surface that puddles cover
   ReturnModel returns_;
   Eigen::Isometry3d mount_;
+  Hdl32eCalibration calibration_;  // how a driver decodes this unit's blocks
   // Per firing slot: the beam's unit vector at zero yaw, with the slot's own yaw advance folded in.
   std::array<Eigen::Vector3f, kHdl32eLasers> slot_direction_;
-  std::vector<Eigen::Vector2f> cycle_yaw_;        // (cos, sin) of each cycle's starting yaw
-  std::vector<uint16_t> cycle_azimuth_;           // each cycle's starting yaw as the encoder reports it
-  std::vector<Hdl32eRotation2d> cycle_rotation_;  // and that azimuth's cosine and sine
-  std::array<double, kHdl32eLasers> slot_cos_elevation_{}, slot_sin_elevation_{};
-  int keyframes_ = 2;  // actor keyframes per scan, evenly spaced from the stamp
+  std::vector<Eigen::Vector2f> cycle_yaw_;  // (cos, sin) of each cycle's starting yaw
+  std::vector<uint16_t> cycle_azimuth_;     // each cycle's starting yaw as the encoder reports it
+  int keyframes_ = 2;                       // actor keyframes per scan, evenly spaced from the stamp
   int64_t keyframe_step_ns_ = 0;
 };
 

@@ -145,7 +145,7 @@ void Simulation::emit_scan(StreamSink& sink) {
   cloud.stamp_ns = stamp_on(scenario_.clocks.lidar, stamp, lidar_clock_rng_, uint64_t(scan_index_));
   const Eigen::Isometry3d sensor_pose = vehicle_pose(stamp) * true_lidar_mount_;
   sink.on_scan(cloud, sensor_pose);
-  sink.on_lidar_rotation(rotation_);
+  sink.on_lidar_rotation(rotation_, cloud.stamp_ns);
   std::vector<ActorSample> states;
   for (const auto& a : resolved_.actors) states.push_back({a.name, a.type, actor_pose2d(a, stamp)});
   sink.on_actors(stamp, states);

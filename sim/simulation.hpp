@@ -34,7 +34,7 @@ class StreamSink {
   virtual void on_scan(const PointCloud&, const Eigen::Isometry3d& /*sensor_pose*/) {}
   // Right after on_scan: the same scan as the HDL-32E sends it (its blocks), on the reference clock
   // (the sensor's clock is GPS-disciplined; the cloud's stamp is the host's, sim/clocks.hpp).
-  virtual void on_lidar_rotation(const Hdl32eRotation&) {}
+  virtual void on_lidar_rotation(const Hdl32eRotation&, int64_t /*stamp_ns*/) {}
   virtual void on_actors(int64_t /*stamp_ns*/, const std::vector<ActorSample>&) {}
   // After each scan: how much of the curb in the localizer's range the traffic hid from the LiDAR at
   // the scan's first firing (sim/curb_visibility.hpp), stamped on the reference clock.

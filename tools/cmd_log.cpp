@@ -8,6 +8,7 @@
 #include "logs/log_export.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/mcap/mcap_recover.hpp"
+#include "loop/recorded_log.hpp"
 #include "tools/commands.hpp"
 
 namespace lidarloop {
@@ -165,14 +166,14 @@ int run_export(const Args& args) {
     r = export_tum(log, *file, topic);
     what = "poses", where = *file;
   } else if (auto dir = args.value("pcd")) {
-    r = export_pcd(log, *dir, topic);
+    r = export_pcd(log, *dir, recorded_calibration(log), topic);
     what = "scans", where = *dir;
   } else if (auto pcap = args.value("pcap")) {
     r = export_pcap(log, *pcap, topic);
     what = "HDL-32E data packets", where = *pcap;
   } else {
     where = *args.value("kitti");
-    r = export_kitti(log, where, topic);
+    r = export_kitti(log, where, recorded_calibration(log), topic);
     what = "scans";
   }
   std::cout << "exported     " << r.count << " " << what << " from " << r.topic << " to " << where << "\n";

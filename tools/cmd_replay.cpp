@@ -16,6 +16,7 @@
 #include "logs/log_topics.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/ros2_messages.hpp"
+#include "logs/scan_messages.hpp"
 #include "logs/tum_file.hpp"
 #include "loop/localizer_backend.hpp"
 #include "loop/localizer_setup.hpp"
@@ -81,6 +82,7 @@ int run_replay(const Args& args) {
   HdMap map = open_scenario_map(scenario, world);
 
   LocalizerBackend localizer(map, params, scenario);
+  const Hdl32eCalibration calibration = scenario.lidar.calibration();
   std::vector<TruthSample> truth;
   std::vector<LocalizerEstimate> estimates;
   std::optional<GpsFix> pending;  // a fix waits for its heading, recorded right after it
@@ -114,8 +116,8 @@ int run_replay(const Args& args) {
       curb_visibility.push_back(ros2::decode_curb_visibility(message.data, context));
     } else if (topic == topics::localizer_status) {
       recorded_statuses.emplace_back(message.data.begin(), message.data.end());
-    } else if (topic == topics::scan) {
-      estimates.push_back(localizer.on_scan(ros2::decode_point_cloud(message.data, context)));
+    } else if (std::optional<PointCloud> scan = scan_message(reader, message, calibration)) {
+      estimates.push_back(localizer.on_scan(*scan));
       ++scans;
     }
   }

@@ -103,7 +103,7 @@ int run_run(const Args& args) {
   // Every output is opened before the map and the run: one that cannot be written fails at once.
   prepare_output_dir(out);
   const std::unique_ptr<RecordingSink> recorder =
-      start_recording(args.value("record"), s.scenario, method_text(params), args.flag("packets"));
+      start_recording(args.value("record"), s.scenario, method_text(params), scan_recording_option(args));
 
   HdMap map = open_scenario_map(s.scenario, s.world);
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
@@ -289,7 +289,7 @@ int run_compare(const Args& args) {
 Command run_command() {
   return {{"run",
            "lidarloop run SCENARIO.yaml [--method NAME] [--loop open|closed] [--out DIR] [--seed N]\n"
-           "                    [--record FILE.mcap [--packets]]",
+           "                    [--record FILE.mcap [--packets|--packets-only]]",
            "Run a scenario with the localizer in the loop and score it against ground truth. Writes\n"
            "metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml and plots to DIR. Exit 0 when\n"
            "every threshold of the scenario's `pass` holds, 1 when one fails, 2 on bad input.",
@@ -306,6 +306,9 @@ Command run_command() {
              "(default: the scenario's localizer.latency; measured for exec:, one_scan for built-in methods)"},
             {"record", "FILE.mcap", "record every stream and the estimates as an MCAP log (replay redoes the run)"},
             {"packets", "", "with --record: also log the HDL-32E's raw UDP packets on /velodyne_packets"},
+            {"packets-only", "",
+             "with --record: log the scans only as the HDL-32E's packets (the sensor's own data rate; "
+             "replay and export decode them)"},
             {"threads", "N", "worker threads (default: all cores)"}},
            1,
            1},
@@ -341,6 +344,12 @@ void apply_deadline_option(const Args& args, LocalizerParams& params) {
   const double ms = args.number("deadline-ms", params.external.deadline_ms);
   if (!(ms > 0 && ms <= kMaxDeadlineMs)) throw InputError("--deadline-ms must be above 0 and at most 60000");
   params.external.deadline_ms = ms;
+}
+
+ScanRecording scan_recording_option(const Args& args) {
+  const bool packets = args.flag("packets"), only = args.flag("packets-only");
+  if (packets && only) throw InputError("--packets and --packets-only: give one of them");
+  return only ? ScanRecording::packets : packets ? ScanRecording::points_and_packets : ScanRecording::points;
 }
 
 }  // namespace lidarloop

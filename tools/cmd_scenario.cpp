@@ -39,7 +39,7 @@ int run_simulate(const Args& args) {
   // The outputs first: one that cannot be written fails before the simulation is built.
   CsvStreams streams(out, LocalFrame(s.world.description.origin), scan_every);
   const std::unique_ptr<RecordingSink> recorder =
-      start_recording(args.value("record"), s.scenario, "", args.flag("packets"));
+      start_recording(args.value("record"), s.scenario, "", scan_recording_option(args));
   Simulation sim(s.scenario, s.world.description, s.world.world, s.world.materials, actors_dir(), threads);
   TeeSink sink(streams, recorder.get());
   const bool terminal = isatty(STDOUT_FILENO);
@@ -84,7 +84,7 @@ Command validate_command() {
 Command simulate_command() {
   return {{"simulate",
            "lidarloop simulate SCENARIO.yaml [--out DIR] [--seed N] [--duration S] [--scan-every N]\n"
-           "                         [--record FILE.mcap [--packets]]",
+           "                         [--record FILE.mcap [--packets|--packets-only]]",
            "Run a scenario's world, ego, traffic and sensors without a localizer; write the streams as CSV,\n"
            "every Nth scan as PLY, and a top view of roads, actors and the ego's path.",
            {{"out", "DIR", "output folder (default out/<scenario name>)"},
@@ -93,6 +93,9 @@ Command simulate_command() {
             {"scan-every", "N", "write every Nth scan as PLY (0: none; default from the scenario, 10)"},
             {"record", "FILE.mcap", "also record every stream as an MCAP log"},
             {"packets", "", "with --record: also log the HDL-32E's raw UDP packets on /velodyne_packets"},
+            {"packets-only", "",
+             "with --record: log the scans only as the HDL-32E's packets (the sensor's own data rate; "
+             "replay and export decode them)"},
             {"threads", "N", "worker threads (default: all cores)"}},
            1,
            1},

@@ -38,5 +38,8 @@ struct LocalizerParams;
 void apply_deadline_option(const Args& args, LocalizerParams& params);
 // --realism ideal|typical|harsh, if given; InputError for any other word.
 std::optional<Realism> realism_option(const Args& args);
+enum class ScanRecording;  // loop/run_recording.hpp
+// --packets / --packets-only: how a recorded log keeps its scans; InputError for both at once.
+ScanRecording scan_recording_option(const Args& args);
 
 }  // namespace lidarloop

@@ -7,6 +7,8 @@
 # the log carries the run's vehicle, so the estimates must still be the live run's.
 # -DLIDARLOOP=... -DSCENARIO=... -DWORKDIR=... [-DMETHOD=...: the run's method, recorded in the log] [-DDATA=...]
 # [-DLATENCY=MS: a fixed latency in closed loop; an exec: program's measured one is not repeatable]
+# [-DPACKETS_ONLY=ON: record the scans only as the HDL-32E's packets, which replay decodes as a driver
+#  does (the live localizer had the same clouds), and export them to PCD files the same way]
 file(REMOVE_RECURSE ${WORKDIR})
 file(MAKE_DIRECTORY ${WORKDIR})
 set(method)
@@ -16,9 +18,13 @@ endif()
 if(LATENCY)
   list(APPEND method --latency ${LATENCY})
 endif()
+set(record)
+if(PACKETS_ONLY)
+  set(record --packets-only)
+endif()
 foreach(threads 1 2)
   execute_process(COMMAND ${LIDARLOOP} run ${SCENARIO} --duration 6 --threads ${threads} ${method}
-                          --record ${WORKDIR}/run_${threads}.mcap --out ${WORKDIR}/live_${threads}
+                          --record ${WORKDIR}/run_${threads}.mcap ${record} --out ${WORKDIR}/live_${threads}
                   RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT code EQUAL 0)
     message(FATAL_ERROR "run at ${threads} thread(s) exited ${code}\n${out}\n${err}")
@@ -61,6 +67,19 @@ foreach(key frames lateral_rmse_m longitudinal_rmse_m heading_rmse_deg max_posit
   endif()
 endforeach()
 message(STATUS "1 and 2 threads: identical logs; replay: identical estimates, truth and metrics")
+if(PACKETS_ONLY)
+  execute_process(COMMAND ${LIDARLOOP} info ${WORKDIR}/run_1.mcap RESULT_VARIABLE code OUTPUT_VARIABLE out)
+  if(NOT code EQUAL 0 OR out MATCHES "/lidar/points" OR NOT out MATCHES "/velodyne_packets")
+    message(FATAL_ERROR "a --packets-only log must have /velodyne_packets and no /lidar/points\n${out}")
+  endif()
+  # 6 s at 10 Hz: 60 scans, each decoded from its packets.
+  execute_process(COMMAND ${LIDARLOOP} export ${WORKDIR}/run_1.mcap --pcd ${WORKDIR}/pcd
+                  RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT code EQUAL 0 OR NOT out MATCHES "exported     60 scans from /velodyne_packets")
+    message(FATAL_ERROR "export --pcd of a --packets-only log exited ${code}\n${out}\n${err}")
+  endif()
+  message(STATUS "--packets-only: no /lidar/points in the log; replay and export decode the packets")
+endif()
 if(DATA)
   file(COPY ${DATA}/assets ${DATA}/maps DESTINATION ${WORKDIR}/data)
   set(vehicle ${WORKDIR}/data/assets/vehicle.yaml)

@@ -136,6 +136,35 @@ TEST(Hdl32ePackets, ARevolutionFillsPacketsOfTwelveBlocks) {
     for (int j = 0; j < 32; ++j) EXPECT_EQ(last.blocks[b].distance[j], 0);
 }
 
+TEST(Hdl32ePackets, ADriverReadsBackARevolutionsBlocks) {
+  Hdl32eRotation r{250'000'000, 46080, std::vector<Hdl32eBlock>(30)};
+  for (size_t k = 0; k < r.blocks.size(); ++k) {
+    r.blocks[k].azimuth = uint16_t(100 * k);
+    r.blocks[k].distance[k % 32] = uint16_t(500 + k);
+    r.blocks[k].intensity[k % 32] = uint8_t(k);
+  }
+  const ros2::VelodyneScan scan{r.start_ns, "lidar", hdl32e_data_packets(r)};
+  const std::vector<Hdl32eBlock> blocks = hdl32e_blocks(scan, "scan");
+  ASSERT_EQ(blocks.size(), 36u);  // 3 packets: 30 blocks and 6 empty ones after them
+  for (size_t k = 0; k < blocks.size(); ++k) {
+    if (k >= r.blocks.size()) {
+      EXPECT_EQ(blocks[k].distance, Hdl32eBlock{}.distance);
+      continue;
+    }
+    EXPECT_EQ(blocks[k].azimuth, r.blocks[k].azimuth);
+    EXPECT_EQ(blocks[k].distance, r.blocks[k].distance);
+    EXPECT_EQ(blocks[k].intensity, r.blocks[k].intensity);
+  }
+  ros2::VelodyneScan broken = scan;
+  broken.packets[2].data[1205] = 0x22;  // not an HDL-32E
+  try {
+    hdl32e_blocks(broken, "log.mcap /velodyne_packets");
+    FAIL() << "a packet of another product was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("log.mcap /velodyne_packets: packet 2"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Hdl32ePackets, NmeaChecksumMatchesAHandComputedSentence) {
   // The textbook RMC example; its checksum 6A is the XOR of every character between $ and *.
   EXPECT_EQ(nmea_checksum("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A"), 0x6A);

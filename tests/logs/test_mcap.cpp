@@ -681,13 +681,13 @@ TEST_F(McapLog, ExportsTumPcdAndKitti) {
   EXPECT_EQ(export_tum(*path_, tum, std::string(topics::truth_odometry)).count, run_->truth.size());
   EXPECT_THROW(export_tum(*path_, tum, "/nothing"), InputError);
 
-  EXPECT_EQ(export_pcd(*path_, pcd).count, run_->scans.size());
+  EXPECT_EQ(export_pcd(*path_, pcd, Hdl32eCalibration{}).count, run_->scans.size());
   const Bytes first_pcd = read_file(pcd + "/000000.pcd");
   const std::string head(first_pcd.begin(), first_pcd.begin() + 300);
   EXPECT_NE(head.find("FIELDS x y z intensity ring time"), std::string::npos);
   EXPECT_NE(head.find("POINTS 500\nDATA binary\n"), std::string::npos);
 
-  EXPECT_EQ(export_kitti(*path_, kitti).count, run_->scans.size());
+  EXPECT_EQ(export_kitti(*path_, kitti, Hdl32eCalibration{}).count, run_->scans.size());
   const Bytes bin = read_file(kitti + "/velodyne_points/data/0000000000.bin");
   ASSERT_EQ(bin.size(), run_->scans[0].points.size() * 16);
   float first[4];

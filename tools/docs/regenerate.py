@@ -359,6 +359,42 @@ def target_sweep(r, commands):
     return {"sweep": "\n".join(body).strip() + "\n"}
 
 
+LOG_SCENARIO, LOG_SECONDS = "scenarios/static_campus.yaml", 60
+# The HDL-32E's own data rate: 181 data packets of 1206 bytes per revolution at 10 Hz (logs/hdl32e_packets.hpp).
+SENSOR_MB_PER_MINUTE = 181 * 1206 * 10 * 60 / 1e6
+
+
+def target_logs(r, commands):
+    """A minute of static_campus recorded three ways, their sizes, and the packets-only log replayed."""
+    out = fresh(os.path.join(WORK, "logs-size"))
+    os.makedirs(out, exist_ok=True)
+    rows, sizes = [], {}
+    for mode, flags, what in (("points", [], "the clouds (`/lidar/points`)"),
+                              ("both", ["--packets"], "clouds and packets (`--packets`)"),
+                              ("packets", ["--packets-only"], "packets only (`--packets-only`)")):
+        log = os.path.join(out, mode + ".mcap")
+        _, seconds, _, shown = r.run(["lidarloop", "run", LOG_SCENARIO, "--duration", str(LOG_SECONDS), "--out",
+                                      os.path.join(out, mode), "--record", log, *flags])
+        commands.append(shown)
+        sizes[mode] = os.path.getsize(log)
+        per_minute = sizes[mode] / 1e6 * 60 / LOG_SECONDS
+        rows.append(f"| {what} | {size_text(sizes[mode])} | {per_minute:.0f} MB | "
+                    f"{sizes[mode] / sizes['points']:.2f} |")
+    replayed, _, _, shown = r.run(["lidarloop", "replay", os.path.join(out, "packets.mcap"), "--out",
+                                   os.path.join(out, "packets-replay")])
+    commands.append(shown)
+    same = read(os.path.join(out, "packets", "estimate.tum")) == read(os.path.join(out, "packets-replay", "estimate.tum"))
+    status = next((line for line in replayed.splitlines() if line.startswith("status")), "status     (none printed)")
+    return {"log-sizes": (
+        f"`{LOG_SCENARIO}` for {LOG_SECONDS} s simulated, recorded each way (zstd chunks; the other topics are the "
+        f"same in all three):\n\n| the log keeps | file | per simulated minute | against the clouds |\n"
+        f"|---|---:|---:|---:|\n" + "\n".join(rows) + "\n\n"
+        f"The sensor itself sends {SENSOR_MB_PER_MINUTE:.0f} MB a minute (181 packets of 1206 bytes a revolution, "
+        f"10 revolutions a second). The packets-only log replayed: `estimate.tum` "
+        f"{'identical to' if same else 'DIFFERENT from'} the live run's, and replay printed:\n\n"
+        f"```text\n{status.strip()}\n```\n")}
+
+
 KARLSRUHE_OSM = "../shared/data/maps/lanelet2/karlsruhe_mapping_example.osm"
 OPENDRIVE_MAPS = "../shared/data/maps/opendrive"
 
@@ -428,6 +464,8 @@ TARGETS = {
                  "the Karlsruhe Lanelet2 map: its world, its HD map, its scenario in open and closed loop, compare"),
     "opendrive": (target_opendrive, {"town01": "docs/opendrive-worlds.md", "fabriksgatan": "docs/opendrive-worlds.md"},
                   "CARLA's Town01 and esmini's fabriksgatan: each world, HD map, scenario open and closed, compare"),
+    "logs": (target_logs, {"log-sizes": "docs/logs.md"},
+             "a minute of static_campus recorded as clouds, clouds and packets, packets only; the last replayed"),
     "sweep": (target_sweep, {"sweep": "docs/sweeps.md"},
               "a 16-run bus occlusion sweep (tools/docs/bus_occlusion_docs.yaml) and its plots"),
 }
