@@ -14,21 +14,30 @@ namespace lidarloop {
 
 namespace {
 
+#ifdef LIDARLOOP_GICP_MODULE
+constexpr const char* kModule = LIDARLOOP_GICP_MODULE;
+#else
+constexpr const char* kModule = nullptr;
+#endif
+
 // Loaded once, by the first thread to need it (a function-local static is initialised once); never
 // unloaded, so the module's code stays valid for every target still alive.
 const GicpBackend& backend() {
   static const GicpBackend* const loaded = [] {
-    void* module = dlopen(LIDARLOOP_GICP_MODULE, RTLD_NOW | RTLD_LOCAL);
+    if (!kModule) throw std::runtime_error(kGicpUnavailable);
+    void* module = dlopen(kModule, RTLD_NOW | RTLD_LOCAL);
     if (!module) throw std::runtime_error(std::string("gicp: cannot load the Open3D module: ") + dlerror());
     using Entry = const GicpBackend* (*)();
     const auto entry = reinterpret_cast<Entry>(dlsym(module, "lidarloop_gicp_backend"));
-    if (!entry) throw std::runtime_error(std::string("gicp: ") + LIDARLOOP_GICP_MODULE + " has no entry point");
+    if (!entry) throw std::runtime_error(std::string("gicp: ") + kModule + " has no entry point");
     return entry();
   }();
   return *loaded;
 }
 
 }  // namespace
+
+bool gicp_available() { return kModule != nullptr; }
 
 struct GicpTarget::Cloud {
   GicpCloud* cloud;

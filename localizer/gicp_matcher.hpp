@@ -106,6 +106,14 @@ class GicpTarget {
   size_t builds_ = 0;
 };
 
+// Whether this build has the gicp method: its Open3D module is built unless configured with
+// -DLIDARLOOP_GICP=OFF, which `tools/quickstart.sh run` does where libopen3d-dev is not installed.
+bool gicp_available();
+// What to tell a user who asks for gicp where it is not available.
+inline constexpr const char* kGicpUnavailable =
+    "gicp: this lidarloop was built without Open3D (-DLIDARLOOP_GICP=OFF, as `tools/quickstart.sh run` builds it "
+    "where libopen3d-dev is not installed); `tools/quickstart.sh test` installs it and builds the method";
+
 enum class GicpStatus { ok, few_scan_points, few_map_points, not_converged, low_fitness };
 const char* gicp_status_name(GicpStatus s);
 

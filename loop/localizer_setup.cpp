@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "common/input_error.hpp"
+#include "localizer/gicp_matcher.hpp"
 #include "loop/kidnap_schedule.hpp"
 #include "mapping/map_cache.hpp"
 #include "mapping/mapping_drive.hpp"
@@ -59,6 +60,7 @@ LocalizerParams localizer_params_for(const Scenario& s, const std::optional<std:
       throw InputError(std::string("--method: ") + e.what());
     }
   }
+  if (p.method == LocalizerMethod::gicp && !gicp_available()) throw InputError(kGicpUnavailable);
   check_kidnaps_supported(s, p);
   return p;
 }
