@@ -259,7 +259,7 @@ PartMaps drive_part(const DriveSetup& d, const IntensityMapHeader& header, const
   const std::vector<ActorPlan> traffic = oncoming_traffic(lane, o);
   std::unique_ptr<RayScene> own_scene;
   if (!traffic.empty()) {
-    own_scene = std::make_unique<RayScene>(d.world.mesh);
+    own_scene = std::make_unique<RayScene>(d.world.mesh, 0, RayScene::MeshBuffers::shared);
     add_actors(*own_scene, traffic, d.actors_dir, d.materials);
   }
   RayScene& scene = own_scene ? *own_scene : d.scene;
@@ -358,7 +358,8 @@ IntensityMapBuilder drive(const WorldDescription& description, const World& worl
   const LidarScanner scanner(lidar, materials, weather_config_for(Realism::ideal));
   const GroundHeight pavement = world.pavement();
   const SurveyDrive survey = mapping_survey(description, o);
-  RayScene scene(world.mesh);
+  // The world's mesh outlives the drive: Embree reads it where it is rather than from a copy.
+  RayScene scene(world.mesh, 0, RayScene::MeshBuffers::shared);
   const DriveSetup setup{world, materials, actors_dir, o, survey, lidar, scanner, scene, pavement};
   const std::vector<DrivePart> parts = plan_parts(header, survey, o, lidar);
 

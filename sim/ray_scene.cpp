@@ -21,13 +21,13 @@ static void check_device(RTCDevice device, const char* what) {
 // rtcNewDevice: the `isa` configuration).
 constexpr const char* kEmbreeIsa = "isa=sse4.2";
 
-RayScene::RayScene(const TriangleMesh& world, int threads) {
+RayScene::RayScene(const TriangleMesh& world, int threads, MeshBuffers buffers) {
   const std::string config = std::string(kEmbreeIsa) + (threads > 0 ? ",threads=" + std::to_string(threads) : "");
   device_ = rtcNewDevice(config.c_str());
   if (!device_) throw std::runtime_error("cannot create an Embree device");
   top_ = rtcNewScene(device_);
   world_triangles_ = world.triangle_count();
-  prototypes_.push_back(make_prototype(world));
+  prototypes_.push_back(make_prototype(world, buffers));
   add_actor(0, Eigen::Isometry3d::Identity());
   actors_.clear();  // the world's instance is not an actor
   instances_.front().actor = -1;
@@ -41,10 +41,12 @@ RayScene::~RayScene() {
   rtcReleaseDevice(device_);
 }
 
-RayScene::Prototype RayScene::make_prototype(const TriangleMesh& mesh) const {
-  RTCScene scene = rtcNewScene(device_);
-  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+namespace {
+
+static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float) && sizeof(std::array<uint32_t, 3>) == 3 * sizeof(unsigned),
+              "shared buffers: a vertex is three packed floats, a triangle three packed indices");
+
+void copy_buffers(RTCGeometry geom, const TriangleMesh& mesh) {
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                         3 * sizeof(float), mesh.vertices.size()));
   for (size_t i = 0; i < mesh.vertices.size(); ++i)
@@ -53,6 +55,27 @@ RayScene::Prototype RayScene::make_prototype(const TriangleMesh& mesh) const {
                                                              3 * sizeof(unsigned), mesh.triangles.size()));
   for (size_t i = 0; i < mesh.triangles.size(); ++i)
     for (int k = 0; k < 3; ++k) idx[3 * i + k] = mesh.triangles[i][k];
+}
+
+// The same arrays, read where they are: the bytes Embree gets are the copy's bytes.
+void share_buffers(RTCGeometry geom, const TriangleMesh& mesh) {
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.vertices.data(), 0,
+                             sizeof(Eigen::Vector3f), mesh.vertices.size());
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.triangles.data(), 0,
+                             sizeof(std::array<uint32_t, 3>), mesh.triangles.size());
+}
+
+}  // namespace
+
+RayScene::Prototype RayScene::make_prototype(const TriangleMesh& mesh, MeshBuffers buffers) const {
+  RTCScene scene = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  const bool padded = mesh.vertices.capacity() > mesh.vertices.size();
+  if (buffers == MeshBuffers::shared && padded)
+    share_buffers(geom, mesh);
+  else
+    copy_buffers(geom, mesh);
   rtcCommitGeometry(geom);
   rtcAttachGeometry(scene, geom);
   rtcReleaseGeometry(geom);
@@ -62,7 +85,7 @@ RayScene::Prototype RayScene::make_prototype(const TriangleMesh& mesh) const {
 }
 
 int RayScene::add_prototype(const TriangleMesh& mesh) {
-  prototypes_.push_back(make_prototype(mesh));
+  prototypes_.push_back(make_prototype(mesh, MeshBuffers::copied));
   return static_cast<int>(prototypes_.size()) - 1;
 }
 
