@@ -96,8 +96,7 @@ std::vector<size_t> split_ground_and_obstacles(const ScanPoints& points, const s
 std::vector<Eigen::Vector2d> detect_scan_curbs(const ScanPoints& points, const std::optional<Plane>& plane,
                                                const CurbDetectorParams& params, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::curb_detection));
-  std::vector<Eigen::Vector2d> curbs =
-      detect_curbs(plane ? level_to_plane(points.xyz, *plane) : points.xyz, points.ring, params);
+  std::vector<Eigen::Vector2d> curbs = detect_curbs(points.xyz, points.ring, params, plane);
   e.curbs_detected = curbs.size();
   return curbs;
 }
