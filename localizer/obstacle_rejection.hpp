@@ -51,11 +51,12 @@ class PlaneLeveller {
  public:
   explicit PlaneLeveller(const Plane& plane);
   Eigen::Vector3d operator()(const Eigen::Vector3d& p) const { return {p.x(), p.y(), height(p)}; }
-
- private:
+  // height_above_plane, without its square root a point.
   double height(const Eigen::Vector3d& p) const {
     return (p.z() - plane_.a0 * p.x() - plane_.a1 * p.y() - plane_.a2) / normal_;
   }
+
+ private:
   Plane plane_;
   double normal_;  // the length of the plane's normal (a0, a1, -1)
 };
