@@ -37,8 +37,10 @@ struct RingPoints {
 // Drops what cannot be a curb and places each ring's points together, in one pass over the scan:
 // every ring has room for all its returns, and each point is written at its ring's next free place,
 // which moves on only if the point passes. So no branch to mispredict on the mix of ground and the rest.
+// `level` gives each point as the detector reads it (see detect_curbs' ground).
+template <class Level>
 RingPoints group_by_ring(const std::vector<Eigen::Vector3d>& points, const std::vector<uint16_t>& rings,
-                         const CurbDetectorParams& p) {
+                         const CurbDetectorParams& p, const Level& level) {
   constexpr size_t kDiscard = kMaxRings;  // where rings beyond kMaxRings write: one place, never kept
   const size_t n = std::min(points.size(), rings.size());
   std::array<size_t, kMaxRings + 1> count{}, next{};
@@ -48,7 +50,7 @@ RingPoints group_by_ring(const std::vector<Eigen::Vector3d>& points, const std::
   for (auto* v : {&g.x, &g.y, &g.z, &g.range}) v->reset(new double[next[kDiscard] + 1]);
   std::copy_n(next.begin(), kMaxRings, g.begin.begin());
   for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d& q = points[i];
+    const Eigen::Vector3d q = level(points[i]);
     const size_t ring = std::min<size_t>(rings[i], kDiscard);
     const double range = q.head<2>().norm();
     const bool keep = q.allFinite() && ring != kDiscard && !(range > p.max_range) && !(range < kMinRange) &&
@@ -264,9 +266,12 @@ void tilt(const Ring& r, size_t a, size_t b, Stretch& stretch, std::vector<doubl
 }  // namespace
 
 std::vector<Eigen::Vector2d> detect_curbs(const std::vector<Eigen::Vector3d>& points,
-                                          const std::vector<uint16_t>& rings, const CurbDetectorParams& p) {
+                                          const std::vector<uint16_t>& rings, const CurbDetectorParams& p,
+                                          const std::optional<Plane>& ground) {
   // Split the scan into rings, keeping firing (azimuth) order; drop what cannot be a curb.
-  const RingPoints by_ring = group_by_ring(points, rings, p);
+  const RingPoints by_ring =
+      ground ? group_by_ring(points, rings, p, PlaneLeveller(*ground))
+             : group_by_ring(points, rings, p, [](const Eigen::Vector3d& q) -> const Eigen::Vector3d& { return q; });
   std::vector<Eigen::Vector2d> curbs;
   std::vector<double> scratch;
   Ring ring;

@@ -8,11 +8,13 @@
 // pan), and the rise is read where each of them, carried along its own tilt, meets the step. Read
 // between the stretches' medians, as the paper's window statistics do, a slope that runs on through
 // both stretches (the 1:10 flares beside a curb ramp, a driveway apron) passes for a curb.
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "common/point_cloud.hpp"
+#include "localizer/obstacle_rejection.hpp"
 
 namespace lidarloop {
 
@@ -27,8 +29,10 @@ struct CurbDetectorParams {
 };
 
 // `points`: the scan in the vehicle frame (x forward, y left, z up from the ground), in firing order.
-// Returns curb points (x, y) in the vehicle frame.
+// With a `ground` plane (2.1.2), heights are read above it instead (level_to_plane, point by point, so
+// the scan is not copied). Returns curb points (x, y) in the vehicle frame.
 std::vector<Eigen::Vector2d> detect_curbs(const std::vector<Eigen::Vector3d>& points,
-                                          const std::vector<uint16_t>& rings, const CurbDetectorParams& params);
+                                          const std::vector<uint16_t>& rings, const CurbDetectorParams& params,
+                                          const std::optional<Plane>& ground = std::nullopt);
 
 }  // namespace lidarloop

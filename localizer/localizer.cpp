@@ -82,8 +82,10 @@ std::vector<size_t> split_ground_and_obstacles(const ScanPoints& points, const s
   if (!split.plane_ok) e.health |= kNoGroundPlane;
   if (split.plane_ok) plane = split.plane;
   std::vector<size_t> ground;
-  for (size_t k : split.ground_index)
-    if (!split.plane_ok || distance_to_plane(split.plane, corridor_xyz[k]) <= params.intensity_grid.max_height)
+  ground.reserve(split.ground_index.size());
+  const PlaneLeveller level(split.plane);
+  for (size_t k : split.ground_index)  // Eq. 3's distance_to_plane
+    if (!split.plane_ok || std::abs(level.height(corridor_xyz[k])) <= params.intensity_grid.max_height)
       ground.push_back(corridor[k]);
   for (const auto& o : split.obstacles) obstacles.push_back(o.head<2>());
   e.obstacle_points = obstacles.size();
@@ -96,8 +98,7 @@ std::vector<size_t> split_ground_and_obstacles(const ScanPoints& points, const s
 std::vector<Eigen::Vector2d> detect_scan_curbs(const ScanPoints& points, const std::optional<Plane>& plane,
                                                const CurbDetectorParams& params, LocalizerEstimate& e) {
   const StageTimer timer(stage_ms(e, Stage::curb_detection));
-  std::vector<Eigen::Vector2d> curbs =
-      detect_curbs(plane ? level_to_plane(points.xyz, *plane) : points.xyz, points.ring, params);
+  std::vector<Eigen::Vector2d> curbs = detect_curbs(points.xyz, points.ring, params, plane);
   e.curbs_detected = curbs.size();
   return curbs;
 }

@@ -113,10 +113,12 @@ double height_above_plane(const Plane& plane, const Eigen::Vector3d& p) {
   return height_above(plane, normal_length(plane), p);
 }
 
+PlaneLeveller::PlaneLeveller(const Plane& plane) : plane_(plane), normal_(normal_length(plane)) {}
+
 std::vector<Eigen::Vector3d> level_to_plane(const std::vector<Eigen::Vector3d>& points, const Plane& plane) {
-  std::vector<Eigen::Vector3d> out(points);
-  const double normal = normal_length(plane);
-  for (Eigen::Vector3d& p : out) p.z() = height_above(plane, normal, p);
+  std::vector<Eigen::Vector3d> out(points.size());
+  const PlaneLeveller level(plane);
+  std::transform(points.begin(), points.end(), out.begin(), level);
   return out;
 }
 

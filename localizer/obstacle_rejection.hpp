@@ -45,6 +45,21 @@ double height_above_plane(const Plane& plane, const Eigen::Vector3d& p);
 // over flat ground would see it. A car on a crowned road rolls by the crown's slope, about 1 deg at 2 %,
 // which lifts the road 9 cm at 5 m to one side and sinks it on the other.
 std::vector<Eigen::Vector3d> level_to_plane(const std::vector<Eigen::Vector3d>& points, const Plane& plane);
+// level_to_plane a point at a time, the normal's length taken once: for a loop that reads the scan
+// anyway (curb detection) and need not copy it first.
+class PlaneLeveller {
+ public:
+  explicit PlaneLeveller(const Plane& plane);
+  Eigen::Vector3d operator()(const Eigen::Vector3d& p) const { return {p.x(), p.y(), height(p)}; }
+  // height_above_plane, without its square root a point.
+  double height(const Eigen::Vector3d& p) const {
+    return (p.z() - plane_.a0 * p.x() - plane_.a1 * p.y() - plane_.a2) / normal_;
+  }
+
+ private:
+  Plane plane_;
+  double normal_;  // the length of the plane's normal (a0, a1, -1)
+};
 
 struct ObstacleSplit {
   std::vector<Eigen::Vector3d> ground, obstacles;
