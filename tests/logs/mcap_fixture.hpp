@@ -33,6 +33,11 @@ struct SyntheticRun {
   std::string scenario_yaml = "world: campus\nduration_s: 1\nseed: 7\n";
 };
 
+// Every field of two points equal, to the bit (a decoded cloud against the one encoded).
+inline bool same_point(const LidarPoint& a, const LidarPoint& b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z && a.intensity == b.intensity && a.ring == b.ring && a.t_ns == b.t_ns;
+}
+
 inline GpsFix synthetic_fix(std::mt19937_64& rng, int64_t t, GpsStatus status) {
   std::uniform_real_distribution<double> u(-1, 1);
   GpsFix f;

@@ -263,12 +263,8 @@ TEST(Ros2Messages, PointCloudRoundTripsExactlyAndRejectsBadLayouts) {
   const PointCloud back = ros2::decode_point_cloud(cdr, "test");
   EXPECT_EQ(back.stamp_ns, cloud.stamp_ns);
   ASSERT_EQ(back.points.size(), cloud.points.size());
-  for (size_t i = 0; i < cloud.points.size(); ++i) {
-    const auto &a = cloud.points[i], &b = back.points[i];
-    EXPECT_TRUE(a.x == b.x && a.y == b.y && a.z == b.z && a.intensity == b.intensity && a.ring == b.ring &&
-                a.t_ns == b.t_ns)
-        << "point " << i;
-  }
+  for (size_t i = 0; i < cloud.points.size(); ++i)
+    EXPECT_TRUE(test::same_point(cloud.points[i], back.points[i])) << "point " << i;
   for (size_t cut : {size_t(3), size_t(40), cdr.size() / 2, cdr.size() - 2})
     EXPECT_THROW(ros2::decode_point_cloud(std::span<const uint8_t>(cdr).first(cut), "test"), InputError) << cut;
   EXPECT_EQ(ros2::to_stamp(-1).sec, -1);

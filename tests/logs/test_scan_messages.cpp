@@ -7,6 +7,7 @@
 
 #include "logs/mcap_recorder.hpp"
 #include "logs/scan_messages.hpp"
+#include "mcap_fixture.hpp"
 
 namespace lidarloop {
 namespace {
@@ -62,12 +63,7 @@ std::vector<PointCloud> scans_of(const std::string& path, const std::string& top
 void expect_same(const PointCloud& a, const PointCloud& b) {
   EXPECT_EQ(a.stamp_ns, b.stamp_ns);
   ASSERT_EQ(a.points.size(), b.points.size());
-  for (size_t k = 0; k < a.points.size(); ++k) {
-    const LidarPoint &p = a.points[k], &q = b.points[k];
-    EXPECT_TRUE(p.x == q.x && p.y == q.y && p.z == q.z && p.intensity == q.intensity && p.ring == q.ring &&
-                p.t_ns == q.t_ns)
-        << "point " << k;
-  }
+  for (size_t k = 0; k < a.points.size(); ++k) EXPECT_TRUE(test::same_point(a.points[k], b.points[k])) << "point " << k;
 }
 
 TEST(ScanMessages, APacketsOnlyLogGivesTheCloudsADriverDecodes) {
