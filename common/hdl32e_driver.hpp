@@ -2,7 +2,7 @@
 // What a Velodyne driver makes of an HDL-32E revolution's blocks: the point cloud a localizer gets.
 // The simulator builds its scans with this very function (sim/lidar_scanner.hpp), and a log's
 // /velodyne_packets decode with it too, so a packets-only log gives back the live run's clouds to
-// the bit (loop/recorded_scans.hpp).
+// the bit (logs/scan_messages.hpp).
 #include <array>
 #include <cstdint>
 #include <span>

@@ -68,7 +68,7 @@ class TeeSink : public StreamSink {
 // What a log keeps of each scan: the cloud a driver made of it (/lidar/points); that and the
 // HDL-32E's raw packets (/velodyne_packets, `--packets`); or the packets alone (`--packets-only`),
 // which is the sensor's own data rate: replay and export decode them as a driver does
-// (loop/recorded_scans.hpp), giving the live run's clouds to the bit.
+// (logs/scan_messages.hpp), giving the live run's clouds to the bit.
 enum class ScanRecording { points, points_and_packets, packets };
 
 // The simulator's streams into an MCAP log (logs/ knows messages, not the simulator).
