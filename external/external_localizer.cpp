@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -45,6 +48,41 @@ double finite_number(const nlohmann::json& answer, const char* key, const std::s
   if (!v.is_number() || !std::isfinite(v.get<double>()))
     throw InputError(where + ": \"" + key + "\" is not a finite number");
   return v.get<double>();
+}
+
+// The keys an answer may hold; anything else is refused, so a misspelled key is found at once.
+const std::vector<std::string>& known_keys() {
+  static const std::vector<std::string> keys = {"scan",     "x",          "y",    "yaw",
+                                                "stamp_ns", "covariance", "lost", "protection"};
+  return keys;
+}
+
+std::string listed(const std::vector<std::string>& keys) {
+  std::string out;
+  for (const auto& k : keys) out += (out.empty() ? "" : ", ") + k;
+  return out;
+}
+
+// "lost": the program's own word that its pose is not to be trusted (LocalizerEstimate::lost).
+bool lost_flag(const nlohmann::json& answer, const std::string& where) {
+  if (!answer.contains("lost")) return false;
+  const auto& v = answer["lost"];
+  if (!v.is_boolean()) throw InputError(where + ": \"lost\" is not true or false");
+  return v.get<bool>();
+}
+
+// "protection": [lateral_m, longitudinal_m], the error the program says its pose stays within, in its
+// own vehicle frame, as the built-in localizer's protection bounds. NaN, none given, without it.
+std::pair<double, double> protection_bounds(const nlohmann::json& answer, const std::string& where) {
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  if (!answer.contains("protection")) return {kNone, kNone};
+  const auto& v = answer["protection"];
+  const std::string expected = ": \"protection\" is not [lateral_m, longitudinal_m], two non-negative numbers";
+  if (!v.is_array() || v.size() != 2) throw InputError(where + expected);
+  for (const auto& bound : v)
+    if (!bound.is_number() || !std::isfinite(bound.get<double>()) || bound.get<double>() < 0)
+      throw InputError(where + expected);
+  return {v[0].get<double>(), v[1].get<double>()};
 }
 
 }  // namespace
@@ -162,10 +200,10 @@ LocalizerEstimate ExternalLocalizer::parse_answer(const std::string& line, const
   if (!answer.is_object()) fail("answer is not a JSON object: " + quoted_excerpt(line), &cloud);
   const std::string where = "answer " + quoted_excerpt(line);
   try {
-    static const std::vector<std::string> known = {"scan", "x", "y", "yaw", "stamp_ns", "covariance"};
+    const std::vector<std::string>& known = known_keys();
     for (const auto& [key, value] : answer.items())
       if (std::find(known.begin(), known.end(), key) == known.end())
-        throw InputError(where + ": unknown key \"" + key + "\" (known: scan, x, y, yaw, stamp_ns, covariance)");
+        throw InputError(where + ": unknown key \"" + key + "\" (known: " + listed(known) + ")");
     if (!answer.contains("scan") || !answer["scan"].is_number_integer())
       throw InputError(where + ": no integer \"scan\"");
     if (answer["scan"].get<int64_t>() != scans_)
@@ -177,13 +215,20 @@ LocalizerEstimate ExternalLocalizer::parse_answer(const std::string& line, const
     const int pose_fields = int(answer.contains("x")) + int(answer.contains("y")) + int(answer.contains("yaw"));
     if (pose_fields != 0 && pose_fields != 3) throw InputError(where + ": give all of x, y and yaw, or none");
     if (pose_fields == 0) {
+      // A scan without a pose is not scored, so a lost flag or bounds on it would be dropped unseen.
+      if (answer.contains("lost") || answer.contains("protection"))
+        throw InputError(where +
+                         ": \"lost\" and \"protection\" describe a pose: give x, y and yaw with them (a "
+                         "lost localizer answers the pose it holds, with \"lost\": true)");
       e.health = kNotInitialized;  // "no estimate": not scored, not steered on
       return e;
     }
-    e.health = 0;
-    // The protocol carries no protection bounds: none given (NaN), not "anywhere" (infinity), so the
-    // scorer does not count the program's frames as bounded.
-    e.protection_lateral_m = e.protection_longitudinal_m = std::numeric_limits<double>::quiet_NaN();
+    // Lost, it is scored as a built-in localizer's lost frame: its error counts, but it is never
+    // misleading nor available, it is left out of NEES, and it marks when `lost` was raised and cleared.
+    e.health = lost_flag(answer, where) ? uint32_t(kLost) : 0u;
+    // Bounds not given stay NaN, not "anywhere" (infinity): the scorer does not count such a frame as
+    // bounded, so a program that gives none is reported as giving none.
+    std::tie(e.protection_lateral_m, e.protection_longitudinal_m) = protection_bounds(answer, where);
     e.pose = {finite_number(answer, "x", where), finite_number(answer, "y", where),
               wrap_angle(finite_number(answer, "yaw", where))};
     if (answer.contains("stamp_ns")) {

@@ -7,8 +7,10 @@
 //     /vehicle/report, /gps/fix, /gps/heading, /lidar/points, and a Metadata record
 //     "lidarloop.external" first (map origin, vehicle, deadlines);
 //   - after each scan it writes one line of JSON to stdout, {"scan": N, "x": .., "y": .., "yaw": ..,
-//     "stamp_ns": .., "covariance": [9]}, or {"scan": N} for "no estimate", and we wait for that line
-//     before sending anything more: lockstep, so closed loop works and runs are deterministic;
+//     "stamp_ns": .., "covariance": [9], "lost": bool, "protection": [lateral_m, longitudinal_m]}, or
+//     {"scan": N} for "no estimate", and we wait for that line before sending anything more: lockstep,
+//     so closed loop works and runs are deterministic. `lost` and `protection` fill the estimate's lost
+//     state and protection bounds, so its integrity is scored as a built-in method's;
 //   - at the end its stdin gets Data End and the Footer, then end-of-file; it must exit with status 0.
 // A program that misses a deadline, writes something else, or exits early ends the run with an
 // InputError naming the scan (exit 2); whatever was recorded so far stays a valid log.

@@ -4,7 +4,8 @@
 // MODE: sleep (sleeps 30 s instead of answering), exit (exits with status 3), garbage (prints a line
 // that is not JSON), wrong-scan (answers for the wrong scan), stop-reading (closes stdin and sleeps),
 // linger (answers every scan, then ignores the end of its input and sleeps 30 s); slow (takes SCAN
-// milliseconds over every answer, for the measured latency in closed loop).
+// milliseconds over every answer, for the measured latency in closed loop); bad-lost ("lost": "yes"),
+// bad-protection (a negative bound), lost-without-pose ("lost": true and no pose).
 #include <unistd.h>
 #include <cstdio>
 #include <cstdlib>
@@ -15,7 +16,9 @@
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    std::fprintf(stderr, "usage: misbehaving_localizer sleep|exit|garbage|wrong-scan|stop-reading|linger|slow SCAN\n");
+    std::fprintf(stderr,
+                 "usage: misbehaving_localizer sleep|exit|garbage|wrong-scan|stop-reading|linger|slow|bad-lost|"
+                 "bad-protection|lost-without-pose SCAN\n");
     return 2;
   }
   const std::string mode = argv[1];
@@ -31,6 +34,10 @@ int main(int argc, char** argv) {
       if (mode == "exit") return 3;
       if (mode == "garbage") std::printf("hello, simulator\n");
       if (mode == "wrong-scan") std::printf("{\"scan\": %d}\n", scan + 1);
+      if (mode == "bad-lost") std::printf("{\"scan\": %d, \"x\": 1, \"y\": 2, \"yaw\": 0, \"lost\": \"yes\"}\n", scan);
+      if (mode == "bad-protection")
+        std::printf("{\"scan\": %d, \"x\": 1, \"y\": 2, \"yaw\": 0, \"protection\": [0.5, -1]}\n", scan);
+      if (mode == "lost-without-pose") std::printf("{\"scan\": %d, \"lost\": true}\n", scan);
       if (mode == "stop-reading") {
         std::fclose(stdin);
         sleep(30);
