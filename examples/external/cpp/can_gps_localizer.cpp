@@ -5,6 +5,9 @@
 //   - take the map's origin and the car's geometry from the "lidarloop.external" metadata;
 //   - after every /lidar/points message, print one JSON line with the pose at the scan's last firing
 //     (or {"scan": N} before the first GPS fix), and flush;
+//   - say how far it can be trusted: protection bounds from its covariance (Integrity), and `lost`
+//     when the GPS keeps disagreeing with it, until it has started over from the GPS and the fixes
+//     agree again;
 //   - exit 0 at the end of the stream.
 // It ignores the scan's points: this is the floor a LiDAR localizer has to beat, not one.
 #include <algorithm>
@@ -48,6 +51,36 @@ struct FilterNoise {
   double yaw_rate_sigma_rad_per_s = 0.01;
 };
 
+// The integrity it claims, stated once: the probability that its error stays within a protection
+// bound, per axis and scan, and that an honest fix passes the GPS's innovation gate. lidarloop's
+// built-in localizer uses the same (localizer/protection_bound.hpp): one frame in ten thousand.
+struct Integrity {
+  double probability = 0.9999;
+  // A fix refused by the gate is left out; this many refused in a row (0.3 s of fixes at 10 Hz) mean
+  // the GPS and the dead reckoning disagree for good: a jump, which a CAN + GPS filter cannot tell
+  // from the car having moved. It then says it is lost and starts over from the next fix. An honest
+  // filter refuses three honest fixes in a row once in 10^12.
+  int lost_after_refused_fixes = 3;
+  // Lost until this many fixes in a row have passed the gate after the new start: the fixes agree
+  // with each other again, so the new level is not a glitch of one fix.
+  int found_after_accepted_fixes = 3;
+};
+
+// k with P(|N(0, 1)| <= k) = probability (3.89 for 0.9999): the bound on one axis is k sigma.
+double normal_two_sided_quantile(double probability) {
+  // P(|N| > k) = erfc(k / sqrt 2) decreases in k: bisection, far below any use's precision.
+  double lo = 0, hi = 40;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (std::erfc(mid / std::sqrt(2.0)) > 1 - probability ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// The squared Mahalanobis distance of a 2-D innovation is chi-square with 2 degrees of freedom, whose
+// quantile has a closed form: P(d^2 <= g) = 1 - exp(-g / 2).
+double chi_square_2_quantile(double probability) { return -2.0 * std::log(1.0 - probability); }
+
 struct Vehicle {
   double wheelbase_m = 2.6, steering_ratio = 16;
   Eigen::Vector2d antenna = Eigen::Vector2d::Zero();  // the GPS antenna in the vehicle frame
@@ -67,7 +100,8 @@ class CanGpsFilter {
   using Covariance = Eigen::Matrix<double, 5, 5>;
   enum { kX, kY, kYaw, kBx, kBy };
 
-  CanGpsFilter(const Vehicle& vehicle, const FilterNoise& noise) : vehicle_(vehicle), noise_(noise) {}
+  CanGpsFilter(const Vehicle& vehicle, const FilterNoise& noise, const Integrity& integrity)
+      : vehicle_(vehicle), noise_(noise), integrity_(integrity), gate_(chi_square_2_quantile(integrity.probability)) {}
 
   void on_can(const CanFrame& f) {
     predict_to(f.stamp_ns);
@@ -80,19 +114,8 @@ class CanGpsFilter {
     const Eigen::Vector2d antenna_xy = frame.to_local(fix.lat_deg, fix.lon_deg);
     const double reported = std::max(fix.position_covariance[0], fix.position_covariance[4]);
     const double white = noise_.gps_white_sigma_m * noise_.gps_white_sigma_m;
-    if (!initialized_) {
-      // The receiver's reported variance is its whole error, bias and scatter. The first fix's bias is
-      // unknown, so the pose inherits it (pose = fix - lever - bias: they are anti-correlated).
-      bias_variance_ = std::max(reported - white, 0.0);
-      const Eigen::Vector2d lever = rotation(fix.heading_rad) * vehicle_.antenna;
-      x_ << antenna_xy - lever, fix.heading_rad, 0, 0;
-      P_.setZero();
-      P_(kX, kX) = P_(kY, kY) = reported;
-      P_(kBx, kBx) = P_(kBy, kBy) = bias_variance_;
-      P_(kX, kBx) = P_(kBx, kX) = P_(kY, kBy) = P_(kBy, kY) = -bias_variance_;
-      P_(kYaw, kYaw) = fix.heading_variance;
-      time_ns_ = fix.stamp_ns;
-      initialized_ = true;
+    if (!initialized_ || start_over_) {
+      start_from(fix, antenna_xy, reported, white);
       return;
     }
     predict_to(fix.stamp_ns);
@@ -103,8 +126,19 @@ class CanGpsFilter {
     H << 1, 0, -lever.y(), 1, 0, 0, 1, lever.x(), 0, 1;
     const Eigen::Matrix2d R = white * Eigen::Matrix2d::Identity();
     const Eigen::Matrix2d S = H * P_ * H.transpose() + R;
+    const Eigen::Vector2d innovation = antenna_xy - predicted;
+    if (innovation.dot(S.inverse() * innovation) > gate_) {  // this fix disagrees: leave it out
+      accepted_in_row_ = 0;
+      if (++refused_in_row_ >= integrity_.lost_after_refused_fixes) {
+        lost_ = true;
+        start_over_ = true;  // from the next fix: this one's disagreement is all we know
+      }
+      return;
+    }
+    refused_in_row_ = 0;
+    if (lost_ && ++accepted_in_row_ >= integrity_.found_after_accepted_fixes) lost_ = false;
     const Eigen::Matrix<double, 5, 2> K = P_ * H.transpose() * S.inverse();
-    x_ += K * (antenna_xy - predicted);
+    x_ += K * innovation;
     x_(kYaw) = wrap_angle(x_(kYaw));
     // Joseph form: stays symmetric and positive over thousands of updates.
     const Covariance IKH = Covariance::Identity() - K * H;
@@ -144,10 +178,29 @@ class CanGpsFilter {
   }
 
   bool initialized() const { return initialized_; }
+  bool lost() const { return lost_; }
   Pose2d pose() const { return {x_(kX), x_(kY), x_(kYaw)}; }
   Eigen::Matrix3d covariance() const { return P_.topLeftCorner<3, 3>(); }  // (x, y, yaw)
 
  private:
+  // The filter from one fix alone: at the start, and after the GPS and the dead reckoning parted.
+  void start_from(const GpsFix& fix, const Eigen::Vector2d& antenna_xy, double reported, double white) {
+    // The receiver's reported variance is its whole error, bias and scatter. The fix's bias is
+    // unknown, so the pose inherits it (pose = fix - lever - bias: they are anti-correlated).
+    bias_variance_ = std::max(reported - white, 0.0);
+    const Eigen::Vector2d lever = rotation(fix.heading_rad) * vehicle_.antenna;
+    x_ << antenna_xy - lever, fix.heading_rad, 0, 0;
+    P_.setZero();
+    P_(kX, kX) = P_(kY, kY) = reported;
+    P_(kBx, kBx) = P_(kBy, kBy) = bias_variance_;
+    P_(kX, kBx) = P_(kBx, kX) = P_(kY, kBy) = P_(kBy, kY) = -bias_variance_;
+    P_(kYaw, kYaw) = fix.heading_variance;
+    time_ns_ = fix.stamp_ns;
+    initialized_ = true;
+    start_over_ = false;
+    refused_in_row_ = accepted_in_row_ = 0;
+  }
+
   static Eigen::Matrix2d rotation(double yaw) {
     Eigen::Matrix2d R;
     R << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
@@ -156,7 +209,11 @@ class CanGpsFilter {
 
   Vehicle vehicle_;
   FilterNoise noise_;
+  Integrity integrity_;
+  double gate_;  // on the innovation's squared Mahalanobis distance
   bool initialized_ = false;
+  bool lost_ = false, start_over_ = false;
+  int refused_in_row_ = 0, accepted_in_row_ = 0;  // consecutive fixes the gate refused, accepted
   int64_t time_ns_ = 0;
   State x_ = State::Zero();
   Covariance P_ = Covariance::Identity();
@@ -164,7 +221,16 @@ class CanGpsFilter {
   double speed_ = 0, steer_ = 0;
 };
 
-void answer(int scan, const CanGpsFilter& filter, int64_t stamp_ns) {
+// The protection bounds: k sigma of the position's covariance across and along the car (its own
+// vehicle frame, as the protocol wants them), k for the stated probability per axis.
+Eigen::Vector2d protection_bounds(const Pose2d& pose, const Eigen::Matrix3d& covariance, double k) {
+  const Eigen::Vector2d forward(std::cos(pose.yaw), std::sin(pose.yaw)), left(-forward.y(), forward.x());
+  const Eigen::Matrix2d P = covariance.topLeftCorner<2, 2>();
+  auto bound = [&](const Eigen::Vector2d& u) { return k * std::sqrt(std::max(0.0, u.dot(P * u))); };
+  return {bound(left), bound(forward)};
+}
+
+void answer(int scan, const CanGpsFilter& filter, int64_t stamp_ns, double k) {
   if (!filter.initialized()) {
     std::printf("{\"scan\": %d}\n", scan);
   } else {
@@ -173,7 +239,9 @@ void answer(int scan, const CanGpsFilter& filter, int64_t stamp_ns) {
     std::printf("{\"scan\": %d, \"stamp_ns\": %lld, \"x\": %.17g, \"y\": %.17g, \"yaw\": %.17g, \"covariance\": [",
                 scan, static_cast<long long>(stamp_ns), p.x, p.y, p.yaw);
     for (int i = 0; i < 9; ++i) std::printf("%s%.17g", i ? ", " : "", c(i / 3, i % 3));
-    std::printf("]}\n");
+    const Eigen::Vector2d bounds = protection_bounds(p, c, k);
+    std::printf("], \"lost\": %s, \"protection\": [%.17g, %.17g]}\n", filter.lost() ? "true" : "false", bounds.x(),
+                bounds.y());
   }
   std::fflush(stdout);  // the simulator waits for this line
 }
@@ -188,6 +256,8 @@ int main() {
     GpsFix fix;  // waits for its heading, which comes right after it
     bool fix_pending = false;
     int scans = 0;
+    const Integrity integrity;
+    const double k = normal_two_sided_quantile(integrity.probability);
     McapMessage m;
     while (reader.next(m)) {
       if (!filter) {  // the metadata comes before the first message
@@ -200,7 +270,7 @@ int main() {
         vehicle.wheelbase_m = number(meta, "vehicle_lf_m") + number(meta, "vehicle_lr_m");
         vehicle.steering_ratio = number(meta, "vehicle_steering_ratio");
         vehicle.antenna = {number(meta, "gps_antenna_x_m"), number(meta, "gps_antenna_y_m")};
-        filter.emplace(vehicle, FilterNoise{});
+        filter.emplace(vehicle, FilterNoise{}, integrity);
       }
       const std::string& topic = m.channel->topic;
       if (topic == log_topics::gps_heading && fix_pending) {
@@ -218,7 +288,7 @@ int main() {
         const PointCloud cloud = ros2::decode_point_cloud(m.data, topic);
         const int64_t t = cloud.stamp_ns + scan_duration_ns(cloud);
         filter->predict_to(t);
-        answer(scans++, *filter, t);
+        answer(scans++, *filter, t, k);
       }
     }
     return 0;

@@ -3,8 +3,8 @@
 standard library only: the CAN + GPS Kalman filter of ../cpp/can_gps_localizer.cpp, reading the MCAP
 stream on stdin record by record and decoding the ROS 2 CDR messages it needs by hand.
 Protocol: docs/external-localizer.md. After every /lidar/points message it prints one JSON line (the
-pose at the scan's last firing, or {"scan": N} before the first fix) and flushes; it logs to stderr,
-because stdout carries the answers only.
+pose at the scan's last firing with its `lost` and protection bounds, or {"scan": N} before the first
+fix) and flushes; it logs to stderr, because stdout carries the answers only.
 
     python3 localizer.py [--verbose]
 """
@@ -253,6 +253,30 @@ NOISE = {
     "yaw_rate_sigma_rad_per_s": 0.01,
 }
 X, Y, YAW, BX, BY = range(5)
+# How far it says it can be trusted: the C++ example's Integrity, the same figures under the same names.
+INTEGRITY = {
+    "probability": 0.9999,
+    "lost_after_refused_fixes": 3,
+    "found_after_accepted_fixes": 3,
+}
+
+
+def normal_two_sided_quantile(probability):
+    """k with P(|N(0, 1)| <= k) = probability: bisection on erfc, which decreases in k."""
+    lo, hi = 0.0, 40.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if math.erfc(mid / math.sqrt(2.0)) > 1 - probability:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+# The gate on a fix's squared Mahalanobis distance: chi-square with 2 degrees of freedom, whose
+# quantile is closed form, P(d^2 <= g) = 1 - exp(-g / 2).
+GATE = -2.0 * math.log(1.0 - INTEGRITY["probability"])
+K_SIGMA = normal_two_sided_quantile(INTEGRITY["probability"])
 
 
 class CanGpsFilter:
@@ -264,6 +288,8 @@ class CanGpsFilter:
         self.steering_ratio = meta("vehicle_steering_ratio")
         self.antenna = (meta("gps_antenna_x_m"), meta("gps_antenna_y_m"))
         self.ready, self.t, self.speed, self.steer = False, 0, 0.0, 0.0
+        # Lost after a run of fixes the gate refused, until fixes pass again after starting over.
+        self.lost, self.start_over, self.refused, self.accepted = False, False, 0, 0
         self.bias_var = 0.0  # the bias's stationary variance per axis, from the first fix
         self.s = [0.0] * 5
         self.P = [[0.0] * 5 for _ in range(5)]
@@ -314,9 +340,9 @@ class CanGpsFilter:
         zx, zy = frame.to_local(fix["lat"], fix["lon"])
         reported = max(fix["covariance"][0], fix["covariance"][4])
         white = NOISE["gps_white_sigma_m"] ** 2
-        if not self.ready:
+        if not self.ready or self.start_over:
             # The receiver's reported variance is its whole error: a bias that wanders over minutes and
-            # the fix-to-fix scatter. The first fix's bias is unknown, so the pose inherits it.
+            # the fix-to-fix scatter. The fix's bias is unknown, so the pose inherits it.
             self.bias_var = max(reported - white, 0.0)
             lx, ly = self.lever(heading)
             self.s = [zx - lx, zy - ly, heading, 0.0, 0.0]
@@ -326,6 +352,7 @@ class CanGpsFilter:
             P[X][BX] = P[BX][X] = P[Y][BY] = P[BY][Y] = -self.bias_var  # pose = fix - bias
             P[YAW][YAW] = heading_variance
             self.P, self.t, self.ready = P, fix["stamp"], True
+            self.start_over, self.refused, self.accepted = False, 0, 0
             return
         self.predict_to(fix["stamp"])
         s = self.s
@@ -337,8 +364,20 @@ class CanGpsFilter:
         S[1][1] += white
         det = S[0][0] * S[1][1] - S[0][1] * S[1][0]
         Si = [[S[1][1] / det, -S[0][1] / det], [-S[1][0] / det, S[0][0] / det]]
-        K = matmul(PHt, Si)
         innovation = [zx - (s[X] + lx + s[BX]), zy - (s[Y] + ly + s[BY])]
+        d2 = sum(innovation[i] * Si[i][j] * innovation[j] for i in range(2) for j in range(2))
+        if d2 > GATE:  # this fix disagrees: leave it out; a run of them and the GPS has parted for good
+            self.accepted = 0
+            self.refused += 1
+            if self.refused >= INTEGRITY["lost_after_refused_fixes"]:
+                self.lost = self.start_over = True
+            return
+        self.refused = 0
+        if self.lost:
+            self.accepted += 1
+            if self.accepted >= INTEGRITY["found_after_accepted_fixes"]:
+                self.lost = False
+        K = matmul(PHt, Si)
         for i in range(5):
             s[i] += K[i][0] * innovation[0] + K[i][1] * innovation[1]
         s[YAW] = wrap(s[YAW])
@@ -352,6 +391,17 @@ class CanGpsFilter:
     def pose_covariance(self):
         """The (x, y, yaw) block, row major."""
         return [self.P[i][j] for i in (X, Y, YAW) for j in (X, Y, YAW)]
+
+    def protection(self):
+        """[lateral_m, longitudinal_m]: K_SIGMA sigma of the position across and along the car."""
+        c, n = math.cos(self.s[YAW]), math.sin(self.s[YAW])
+        P = self.P
+
+        def bound(ux, uy):
+            variance = ux * ux * P[X][X] + 2 * ux * uy * P[X][Y] + uy * uy * P[Y][Y]
+            return K_SIGMA * math.sqrt(max(0.0, variance))
+
+        return [bound(-n, c), bound(c, n)]
 
 
 def main():
@@ -397,7 +447,8 @@ def main():
                 kf.predict_to(t)
                 answer = {"scan": scans}
                 if kf.ready:
-                    answer.update(stamp_ns=t, x=kf.s[X], y=kf.s[Y], yaw=kf.s[YAW], covariance=kf.pose_covariance())
+                    answer.update(stamp_ns=t, x=kf.s[X], y=kf.s[Y], yaw=kf.s[YAW], covariance=kf.pose_covariance(),
+                                  lost=kf.lost, protection=kf.protection())
                 out.write(json.dumps(answer) + "\n")
                 out.flush()  # a pipe is not a terminal: unflushed, the answer would wait in a buffer
                 scans += 1

@@ -1,0 +1,42 @@
+# The C++ example (examples/external/cpp/can_gps_localizer.cpp) on a GPS jump: it gates each fix on its
+# innovation and says it is lost when three in a row disagree, so on scenarios/gps_jump_parked.yaml
+# (a 4 m multipath jump from 8 s to 16 s) `lost` must be raised within the scenario's lost_within_s of
+# the jump and cleared afterwards, and its frames must carry protection bounds. The run itself fails the
+# scenario's thresholds, which are a map-matching method's (exit 1): a CAN + GPS filter is metres off.
+# -DLIDARLOOP=... -DSCENARIO=... -DMETHOD=exec:... -DWORKDIR=...
+file(REMOVE_RECURSE ${WORKDIR})
+execute_process(COMMAND ${LIDARLOOP} run ${SCENARIO} --method ${METHOD} --out ${WORKDIR}
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
+if(NOT code EQUAL 0 AND NOT code EQUAL 1)
+  message(FATAL_ERROR "the example's run exited ${code}\n${out}\n${err}")
+endif()
+message(STATUS "${out}")
+file(READ ${WORKDIR}/metrics.json metrics)
+string(JSON bounded GET "${metrics}" integrity frames_with_bounds)
+string(JSON awaiting GET "${metrics}" integrity frames_awaiting_alert)  # bounded too, counted apart
+string(JSON frames GET "${metrics}" frames)
+math(EXPR bounded "${bounded} + ${awaiting}")
+if(NOT bounded EQUAL frames)
+  message(FATAL_ERROR "${bounded} of ${frames} frames carry protection bounds: the example gives them with every pose")
+endif()
+string(JSON lost_within GET "${metrics}" thresholds recovery lost_within_s)
+string(JSON events LENGTH "${metrics}" recovery)
+math(EXPR last "${events} - 1")
+set(jumps 0)
+foreach(i RANGE ${last})
+  string(JSON event GET "${metrics}" recovery ${i} event)
+  if(NOT event STREQUAL "gps jump")
+    continue()
+  endif()
+  math(EXPR jumps "${jumps} + 1")
+  string(JSON raised GET "${metrics}" recovery ${i} lost_raised_after_s)
+  string(JSON cleared GET "${metrics}" recovery ${i} lost_cleared_after_s)
+  # A null is not a number, so it fails these comparisons too.
+  if(NOT raised GREATER_EQUAL 0 OR raised GREATER lost_within OR NOT cleared GREATER raised)
+    message(FATAL_ERROR "the gps jump: lost raised after ${raised} s (at most ${lost_within} s), cleared after "
+                        "${cleared} s: expected raised in time and cleared after it")
+  endif()
+endforeach()
+if(NOT jumps EQUAL 1)
+  message(FATAL_ERROR "expected one gps jump in metrics.json's recovery, found ${jumps}")
+endif()
