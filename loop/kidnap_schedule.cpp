@@ -31,7 +31,8 @@ std::vector<Pose2d> KidnapSchedule::due(int64_t scan_stamp_ns) {
 void check_kidnaps_supported(const Scenario& scenario, const LocalizerParams& params) {
   if (!scenario.kidnaps.empty() && !params.external.command.empty())
     throw InputError(scenario.file + ": faults: kidnap needs a built-in localizer method (" + method_label(params) +
-                     " is an external program, whose pose lidarloop cannot move)");
+                     " is an external program, whose belief lidarloop cannot move; moving its GPS instead would "
+                     "be a GPS jump, not a kidnap: see docs/external-localizer.md)");
 }
 
 }  // namespace lidarloop

@@ -34,7 +34,11 @@ class KidnapSchedule {
 };
 
 // An external program's pose cannot be moved from outside (its protocol has no such message), so a
-// scenario with kidnaps needs a built-in method: InputError naming the scenario otherwise.
+// scenario with kidnaps needs a built-in method: InputError naming the scenario otherwise. Nor can a
+// kidnap be faked by moving the program's world-frame inputs (the GPS) by the offset and its answers
+// back: its map and its LiDAR would still agree with its belief, so it would see the GPS jump away from
+// both, a GPS jump and not a kidnap, in which the map and every sensor disagree with the belief
+// (docs/external-localizer.md, "No kidnaps").
 void check_kidnaps_supported(const Scenario& scenario, const LocalizerParams& params);
 
 }  // namespace lidarloop
