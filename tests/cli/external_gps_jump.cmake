@@ -1,4 +1,4 @@
-# The C++ example (examples/external/cpp/can_gps_localizer.cpp) on a GPS jump: it gates each fix on its
+# The C++ or Python example (examples/external/) on a GPS jump: it gates each fix on its
 # innovation and says it is lost when three in a row disagree, so on scenarios/gps_jump_parked.yaml
 # (a 4 m multipath jump from 8 s to 16 s) `lost` must be raised within the scenario's lost_within_s of
 # the jump and cleared afterwards, and its frames must carry protection bounds. The run itself fails the
