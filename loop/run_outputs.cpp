@@ -10,6 +10,7 @@
 #include "loop/fault_events.hpp"
 #include "scoring/birdseye.hpp"
 #include "scoring/error_plots.hpp"
+#include "scoring/reference_trajectory.hpp"
 #include "scoring/result_files.hpp"
 #include "sim/sensor_calibration.hpp"
 
@@ -71,8 +72,14 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
                           const std::vector<CurbVisibility>& curb_visibility, const std::string& failure) {
   const std::vector<FaultEvent> events =
       truth.empty() ? std::vector<FaultEvent>{} : fault_events(scenario, truth.front().stamp_ns);
+  // The reference, drawn from the truth and the seed here rather than in the simulation: the same in
+  // `run`, `compare`, `replay` and `score`, and no stream of the drive changes with it.
+  const bool with_reference = scenario.reference.kind != ReferenceConfig::Kind::none && !truth.empty();
+  const std::vector<TruthPose> reference =
+      with_reference ? reference_trajectory(truth, scenario.reference, scenario.seed) : std::vector<TruthPose>{};
   ScoredRun scored = score(truth, estimates, route, scenario.pass, method, scenario_name, events, curb_visibility,
-                           scenario.lidar.scan_period_ns());
+                           scenario.lidar.scan_period_ns(), reference);
+  if (scored.metrics.reference) scored.metrics.reference->config = scenario.reference;
   if (!failure.empty()) {
     scored.metrics.failures.push_back(failure);
     scored.metrics.pass = false;
@@ -88,6 +95,10 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
   write_errors_csv(dir + "/errors.csv", scored, estimates);
   write_tum(dir + "/estimate.tum", estimates);
   write_tum(dir + "/truth.tum", truth);
+  if (with_reference)
+    write_tum(dir + "/reference.tum", reference);
+  else
+    std::filesystem::remove(dir + "/reference.tum");  // an earlier run's in the same folder is not this run's
   write_junit(dir + "/junit.xml", {scored.metrics});
   write_error_plot(dir + "/errors.png", scored.errors, events);
   write_trajectory_plot(dir + "/trajectory.png", truth, estimates, scored.errors, map.curbs.map().curbs);

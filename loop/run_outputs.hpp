@@ -21,7 +21,9 @@ std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate
 // Scores one method's run with the pure scorer (scoring/scorer.hpp: the thresholds and settle time from
 // the scenario, lane keeping along `route`, coverage by the scenario's LiDAR scan period), then
 // writes its files into `dir`: metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml,
-// errors.png, trajectory.png, and worst_frame.png when `worst` is given (else none). `realism`,
+// errors.png, trajectory.png, and worst_frame.png when `worst` is given (else none); reference.tum too
+// when the scenario has a reference (its `reference`, drawn here from the truth and the seed:
+// scoring/reference_trajectory.hpp), which the run is scored against beside the truth. `realism`,
 // the mount error, the thresholds and the fault events (loop/fault_events.hpp, from the first truth
 // stamp) come from `scenario`. `curb_visibility`: the simulator's
 // per-scan records (empty when not known). `failure`: what failed the method beyond the thresholds (an

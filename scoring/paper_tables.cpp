@@ -43,15 +43,16 @@ std::string ours(const SeedSpread& s, size_t seeds) {
 }
 }  // namespace
 
-std::vector<MethodOverSeeds> summarise_over_seeds(const std::vector<Metrics>& runs) {
+std::vector<MethodOverSeeds> summarise_over_seeds(const std::vector<Metrics>& runs, bool against_reference) {
   std::vector<MethodOverSeeds> out;
   for (const Metrics& m : runs) {
+    if (against_reference && !m.reference) continue;
     auto it = std::find_if(out.begin(), out.end(), [&](const MethodOverSeeds& o) { return o.method == m.method; });
     if (it == out.end()) it = out.insert(out.end(), MethodOverSeeds{m.method, 0, {}, {}, {}});
     const size_t n = ++it->seeds;
-    add(it->lateral_m, m.lateral_rmse_m, n);
-    add(it->longitudinal_m, m.longitudinal_rmse_m, n);
-    add(it->heading_deg, m.heading_rmse_deg, n);
+    add(it->lateral_m, against_reference ? m.reference->lateral_rmse_m : m.lateral_rmse_m, n);
+    add(it->longitudinal_m, against_reference ? m.reference->longitudinal_rmse_m : m.longitudinal_rmse_m, n);
+    add(it->heading_deg, against_reference ? m.reference->heading_rmse_deg : m.heading_rmse_deg, n);
   }
   return out;
 }

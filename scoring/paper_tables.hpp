@@ -30,8 +30,10 @@ struct MethodOverSeeds {
   SeedSpread lateral_m, longitudinal_m, heading_deg;
 };
 
-// Groups `runs` (one Metrics per method and seed) by method, in first-seen order.
-std::vector<MethodOverSeeds> summarise_over_seeds(const std::vector<Metrics>& runs);
+// Groups `runs` (one Metrics per method and seed) by method, in first-seen order. `against_reference`:
+// the RMSEs against each run's reference (Metrics::reference) instead of the truth, as the paper's own
+// were measured; runs without a reference are left out (none: an empty summary).
+std::vector<MethodOverSeeds> summarise_over_seeds(const std::vector<Metrics>& runs, bool against_reference = false);
 
 // Markdown: method | lateral paper / ours | longitudinal paper / ours | heading paper / ours, ours as
 // "mean (min-max)".

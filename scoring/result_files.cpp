@@ -94,6 +94,27 @@ json recovery_json(const std::vector<EventRecovery>& events) {
   return out;
 }
 
+json reference_json(const std::optional<ReferenceAccuracy>& reference) {
+  if (!reference) return nullptr;
+  const ReferenceAccuracy& r = *reference;
+  return {{"kind", reference_kind_name(r.config.kind)},
+          {"sigma_xy_m", r.config.sigma_xy_m},
+          {"heading_sigma_deg", r.config.heading_sigma_rad * kDegPerRad},
+          {"correlation_s", r.config.correlation_s},
+          {"lateral_rmse_m", finite_or_null(r.lateral_rmse_m)},
+          {"longitudinal_rmse_m", finite_or_null(r.longitudinal_rmse_m)},
+          {"heading_rmse_deg", finite_or_null(r.heading_rmse_deg)},
+          {"position_rmse_m", finite_or_null(r.position_rmse_m)},
+          {"max_position_error_m", finite_or_null(r.max_position_error_m)},
+          {"max_lateral_m", finite_or_null(r.max_lateral_m)},
+          {"max_longitudinal_m", finite_or_null(r.max_longitudinal_m)},
+          {"max_heading_deg", finite_or_null(r.max_heading_deg)},
+          {"reference_error",
+           {{"lateral_rms_m", finite_or_null(r.error_lateral_rms_m)},
+            {"longitudinal_rms_m", finite_or_null(r.error_longitudinal_rms_m)},
+            {"heading_rms_deg", finite_or_null(r.error_heading_rms_deg)}}}};
+}
+
 std::string markdown_cell(std::string s) {
   std::string out;
   for (char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c);
@@ -148,6 +169,7 @@ std::string metrics_json(const Metrics& m) {
       {"max_longitudinal_m", finite_or_null(m.max_longitudinal_m)},
       {"max_heading_deg", finite_or_null(m.max_heading_deg)},
       {"worst_frame_t_s", double(m.worst_frame_stamp_ns) / double(kNsPerS)},
+      {"reference", reference_json(m.reference)},
       {"latency_p50_ms", finite_or_null(m.latency_p50_ms)},
       {"latency_p99_ms", finite_or_null(m.latency_p99_ms)},
       {"latency_max_ms", finite_or_null(m.latency_max_ms)},
@@ -176,7 +198,8 @@ std::string metrics_json(const Metrics& m) {
         {"availability", finite_or_null(m.integrity.availability)}}},
       {"recovery", recovery_json(m.recovery)},
       {"thresholds",
-       {{"lateral_rmse_m", optional_or_null(m.thresholds.lateral_rmse_m)},
+       {{"against", m.thresholds.against_reference ? "reference" : "truth"},
+        {"lateral_rmse_m", optional_or_null(m.thresholds.lateral_rmse_m)},
         {"longitudinal_rmse_m", optional_or_null(m.thresholds.longitudinal_rmse_m)},
         {"heading_rmse_deg", optional_or_null(m.thresholds.heading_rmse_deg)},
         {"max_position_error_m", optional_or_null(m.thresholds.max_position_error_m)},
@@ -235,6 +258,24 @@ std::string recovery_text(const EventRecovery& r) {
   return r.event.what + " at " + format("%.2f s", double(r.event.stamp_ns) / double(kNsPerS)) + ": converged after " +
          cell(r.converged_after_s, "%.2f s") + ", lost raised after " + cell(r.lost_raised_after_s, "%.2f s") +
          ", cleared after " + cell(r.lost_cleared_after_s, "%.2f s");
+}
+
+std::string reference_text(const Metrics& m) {
+  if (!m.reference) return "none: scored against the truth only";
+  const ReferenceAccuracy& r = *m.reference;
+  return std::string(reference_kind_name(r.config.kind)) + " (" + format("%.3f m per axis, ", r.config.sigma_xy_m) +
+         format("%.2f deg, ", r.config.heading_sigma_rad * kDegPerRad) +
+         format("correlation %.0f s", r.config.correlation_s) + "): against it lateral RMSE " +
+         cell(r.lateral_rmse_m, "%.3f m") + ", longitudinal RMSE " + cell(r.longitudinal_rmse_m, "%.3f m") +
+         ", heading RMSE " + cell(r.heading_rmse_deg, "%.3f deg") + ", max position error " +
+         cell(r.max_position_error_m, "%.3f m") + "; itself off the truth by " + cell(r.error_lateral_rms_m, "%.3f m") +
+         " lateral, " + cell(r.error_longitudinal_rms_m, "%.3f m") + " longitudinal, " +
+         cell(r.error_heading_rms_deg, "%.3f deg") + " heading (RMS)";
+}
+
+std::string reference_lines(const Metrics& m, const std::string& label) {
+  if (!m.reference) return "";
+  return "reference  " + (label.empty() ? "" : label + ": ") + reference_text(m) + "\n";
 }
 
 std::string latency_text(const Metrics& m) {
@@ -344,6 +385,30 @@ std::string comparison_markdown(const std::vector<Metrics>& runs) {
           cell(m.longitudinal_rmse_m, "%.3f") + " | " + cell(m.heading_rmse_deg, "%.3f") + " | " +
           cell(m.max_position_error_m, "%.3f") + " | " + cell(m.latency_p50_ms, "%.2f") + " | " +
           cell(100 * m.coverage, "%.1f%%") + " | " + (m.pass ? "pass" : "FAIL") + " |\n";
+  }
+  return md;
+}
+
+std::string reference_markdown(const std::vector<Metrics>& runs) {
+  bool any = false, several_scenarios = false;
+  for (const auto& m : runs) {
+    any |= m.reference.has_value();
+    several_scenarios |= m.scenario != runs.front().scenario;
+  }
+  if (!any) return "";
+  std::string md = std::string(several_scenarios ? "| scenario " : "") +
+                   "| method | lateral RMSE m: truth | reference | longitudinal RMSE m: truth | reference | "
+                   "heading RMSE deg: truth | reference | max error m: truth | reference |\n" +
+                   (several_scenarios ? "|---" : "") + "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const auto& m : runs) {
+    if (!m.reference) continue;
+    const ReferenceAccuracy& r = *m.reference;
+    if (several_scenarios) md += "| " + markdown_cell(m.scenario) + ' ';
+    md += "| " + markdown_cell(m.method) + " | " + cell(m.lateral_rmse_m, "%.3f") + " | " +
+          cell(r.lateral_rmse_m, "%.3f") + " | " + cell(m.longitudinal_rmse_m, "%.3f") + " | " +
+          cell(r.longitudinal_rmse_m, "%.3f") + " | " + cell(m.heading_rmse_deg, "%.3f") + " | " +
+          cell(r.heading_rmse_deg, "%.3f") + " | " + cell(m.max_position_error_m, "%.3f") + " | " +
+          cell(r.max_position_error_m, "%.3f") + " |\n";
   }
   return md;
 }

@@ -19,7 +19,7 @@ std::optional<std::string> read_text_file(const std::string& path);
 std::string csv_field(const std::string& s);
 
 // metrics.json: every Metrics field (thresholds as an object, unset ones null; undefined values such
-// as the RMSE of zero frames are null too, since JSON has no NaN).
+// as the RMSE of zero frames are null too, since JSON has no NaN); `reference` null without one.
 std::string metrics_json(const Metrics& metrics);
 void write_metrics_json(const std::string& path, const Metrics& metrics);
 
@@ -45,7 +45,12 @@ void write_junit(const std::string& path, const std::vector<Metrics>& runs);
 // Like the paper's Table III: method | lateral RMSE m | longitudinal RMSE m | heading RMSE deg |
 // max error m | latency p50 ms | coverage | pass. A scenario column is added when the runs span several.
 std::string comparison_markdown(const std::vector<Metrics>& runs);
-// The same columns (and always the scenario) with full precision.
+// The accuracy against the truth and against the reference side by side, for the runs that have a
+// reference (Metrics::reference): method | lateral RMSE m: truth | reference | longitudinal ... |
+// heading ... | max error m: truth | reference; a scenario column when the runs span several. Empty
+// when no run has a reference.
+std::string reference_markdown(const std::vector<Metrics>& runs);
+// The same columns as comparison_markdown (and always the scenario) with full precision.
 void write_comparison_csv(const std::string& path, const std::vector<Metrics>& runs);
 
 // For people: how much of the curb the traffic hid over the run and in its worst scan, e.g.
@@ -61,6 +66,12 @@ std::string recovery_text(const EventRecovery& r);
 // The three above as a command's summary lines ("nees       ...", "integrity  ...", one "recovery   ..."
 // per event), each after "label: " when a label is given (a method, in a comparison).
 std::string integrity_lines(const Metrics& m, const std::string& label = "");
+// For people: the run's reference and the accuracy against it, e.g. "rtk (0.030 m per axis, 0.10 deg,
+// correlation 30 s): against it lateral RMSE 0.190 m, ...; itself off the truth by 0.031 m lateral, ...".
+std::string reference_text(const Metrics& m);
+// The above as a command's summary line ("reference  ..."), after "label: " when a label is given;
+// empty without a reference, so a run without one prints what it always did.
+std::string reference_lines(const Metrics& m, const std::string& label = "");
 // The localizer's time per scan: p50, p99 and max, and the first scan's (with the start-up) apart.
 std::string latency_text(const Metrics& m);
 

@@ -75,6 +75,51 @@ void check_recovery(Metrics& m, const EventRecovery& r, const PassThresholds::Re
     m.failures.push_back(prefix + "lost was never cleared");
 }
 
+// The accuracy figures of a run (Metrics' RMSEs and maxima) from its frames, in the order given.
+struct AccuracyTally {
+  std::vector<double> lateral, longitudinal, heading_deg, position;
+  double max_position_error_m = 0, max_lateral_m = 0, max_longitudinal_m = 0, max_heading_deg = 0;
+  int64_t worst_frame_stamp_ns = 0;
+
+  void add(const FrameError& e) {
+    lateral.push_back(e.lateral_m);
+    longitudinal.push_back(e.longitudinal_m);
+    heading_deg.push_back(e.heading_rad * kDegPerRad);
+    position.push_back(e.position_m);
+    // `!(a <= b)` so a NaN error becomes the worst frame rather than being skipped.
+    if (position.size() == 1 || !(e.position_m <= max_position_error_m)) {
+      max_position_error_m = e.position_m;
+      worst_frame_stamp_ns = e.stamp_ns;
+    }
+    max_lateral_m = std::max(max_lateral_m, std::abs(e.lateral_m));
+    max_longitudinal_m = std::max(max_longitudinal_m, std::abs(e.longitudinal_m));
+    max_heading_deg = std::max(max_heading_deg, std::abs(e.heading_rad) * kDegPerRad);
+  }
+};
+
+// Metrics' or ReferenceAccuracy's figures from a tally; the maxima NaN without a frame.
+template <typename Figures>
+void set_accuracy(Figures& f, const AccuracyTally& t) {
+  f.lateral_rmse_m = rmse(t.lateral);
+  f.longitudinal_rmse_m = rmse(t.longitudinal);
+  f.heading_rmse_deg = rmse(t.heading_deg);
+  f.position_rmse_m = rmse(t.position);
+  const bool none = t.position.empty();
+  f.max_position_error_m = none ? kNaN : t.max_position_error_m;
+  f.max_lateral_m = none ? kNaN : t.max_lateral_m;
+  f.max_longitudinal_m = none ? kNaN : t.max_longitudinal_m;
+  f.max_heading_deg = none ? kNaN : t.max_heading_deg;
+}
+
+// The reference must be drawn at the truth's samples: interpolating it elsewhere would blend two
+// draws the scorer never chose.
+void check_reference_stamps(const std::vector<TruthPose>& truth, const std::vector<TruthPose>& reference) {
+  const bool same = reference.size() == truth.size() &&
+                    std::equal(truth.begin(), truth.end(), reference.begin(),
+                               [](const TruthPose& a, const TruthPose& b) { return a.stamp_ns == b.stamp_ns; });
+  if (!same) throw std::invalid_argument("score: the reference's stamps are not the ground truth's");
+}
+
 }  // namespace
 
 FrameError frame_error(const Pose2d& truth, const Pose2d& estimate) {
@@ -348,7 +393,7 @@ bool recovering(int64_t stamp_ns, const PassThresholds& thresholds, const std::v
 ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates, const Path& route,
                 const PassThresholds& thresholds, const std::string& method, const std::string& scenario,
                 const std::vector<FaultEvent>& events, const std::vector<CurbVisibility>& curb_visibility,
-                int64_t scan_period_ns) {
+                int64_t scan_period_ns, const std::vector<TruthPose>& reference) {
   if (!std::is_sorted(truth.begin(), truth.end(),
                       [](const TruthPose& a, const TruthPose& b) { return a.stamp_ns < b.stamp_ns; }))
     throw std::invalid_argument("score: ground truth is not sorted by stamp");
@@ -360,7 +405,10 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
 
   const PassThresholds::Recovery recovery_criteria = thresholds.recovery.value_or(PassThresholds::Recovery{});
 
-  std::vector<double> lateral, longitudinal, heading_deg, position, latency;
+  const bool with_reference = !reference.empty();
+  if (with_reference) check_reference_stamps(truth, reference);
+  AccuracyTally accuracy, against_reference, reference_error;
+  std::vector<double> latency;
   std::vector<FrameError> in_range;  // every estimate in the truth's range, settling or not: for recovery
   for (size_t i = 0; i < estimates.size(); ++i) {
     const EstimateRecord& est = estimates[i];
@@ -384,18 +432,12 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
       ++m.recovery_frames;
       continue;
     }
-    lateral.push_back(e.lateral_m);
-    longitudinal.push_back(e.longitudinal_m);
-    heading_deg.push_back(e.heading_rad * kDegPerRad);
-    position.push_back(e.position_m);
-    // `!(a <= b)` so a NaN error becomes the worst frame rather than being skipped.
-    if (position.size() == 1 || !(e.position_m <= m.max_position_error_m)) {
-      m.max_position_error_m = e.position_m;
-      m.worst_frame_stamp_ns = e.stamp_ns;
+    accuracy.add(e);
+    if (with_reference) {
+      const Pose2d at_reference = truth_at(reference, est.stamp_ns);
+      against_reference.add(frame_error(at_reference, est.pose));
+      reference_error.add(frame_error(e.truth, at_reference));
     }
-    m.max_lateral_m = std::max(m.max_lateral_m, std::abs(e.lateral_m));
-    m.max_longitudinal_m = std::max(m.max_longitudinal_m, std::abs(e.longitudinal_m));
-    m.max_heading_deg = std::max(m.max_heading_deg, std::abs(e.heading_rad) * kDegPerRad);
   }
   m.frames = run.errors.size();
   std::sort(in_range.begin(), in_range.end(),
@@ -404,24 +446,39 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
   mark_awaiting_alert(run.errors, m.recovery, recovery_criteria.lost_within_s);
   m.consistency = consistency(run.errors);
   m.integrity = integrity(run.errors, thresholds.alert_limit_lateral_m, thresholds.alert_limit_longitudinal_m);
-  m.lateral_rmse_m = rmse(lateral);
-  m.longitudinal_rmse_m = rmse(longitudinal);
-  m.heading_rmse_deg = rmse(heading_deg);
-  m.position_rmse_m = rmse(position);
+  set_accuracy(m, accuracy);
+  m.worst_frame_stamp_ns = accuracy.worst_frame_stamp_ns;
+  if (with_reference) {
+    ReferenceAccuracy r;
+    set_accuracy(r, against_reference);
+    r.error_lateral_rms_m = rmse(reference_error.lateral);
+    r.error_longitudinal_rms_m = rmse(reference_error.longitudinal);
+    r.error_heading_rms_deg = rmse(reference_error.heading_deg);
+    m.reference = r;
+  }
   m.latency_p50_ms = percentile_nearest_rank(latency, kMedianPercent);
   m.latency_p99_ms = percentile_nearest_rank(latency, kTailPercent);
   m.latency_max_ms = latency.empty() ? kNaN : *std::max_element(latency.begin(), latency.end());
   const Coverage coverage = estimate_coverage(truth, estimates, scan_period_ns);
   m.coverage = coverage.fraction;
   m.largest_gap_s = coverage.largest_gap_s;
-  if (position.empty()) m.max_position_error_m = m.max_lateral_m = m.max_longitudinal_m = m.max_heading_deg = kNaN;
   if (m.frames == 0) {
     m.failures.push_back(estimates.empty() ? "no estimates" : "no estimates within the ground truth's time range");
+  } else if (thresholds.against_reference && !m.reference) {
+    m.failures.push_back("the accuracy thresholds are against the reference, but the run has none");
+  } else if (thresholds.against_reference) {
+    const ReferenceAccuracy& r = *m.reference;
+    check(m, "lateral RMSE against the reference", r.lateral_rmse_m, thresholds.lateral_rmse_m, "m");
+    check(m, "longitudinal RMSE against the reference", r.longitudinal_rmse_m, thresholds.longitudinal_rmse_m, "m");
+    check(m, "heading RMSE against the reference", r.heading_rmse_deg, thresholds.heading_rmse_deg, "deg");
+    check(m, "max position error against the reference", r.max_position_error_m, thresholds.max_position_error_m, "m");
   } else {
     check(m, "lateral RMSE", m.lateral_rmse_m, thresholds.lateral_rmse_m, "m");
     check(m, "longitudinal RMSE", m.longitudinal_rmse_m, thresholds.longitudinal_rmse_m, "m");
     check(m, "heading RMSE", m.heading_rmse_deg, thresholds.heading_rmse_deg, "deg");
     check(m, "max position error", m.max_position_error_m, thresholds.max_position_error_m, "m");
+  }
+  if (m.frames > 0) {
     check_at_least(m, "coverage", m.coverage, thresholds.min_coverage);
     const Consistency& c = m.consistency;
     for (const auto& [axis, mean] :

@@ -39,6 +39,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -142,6 +143,27 @@ struct EventRecovery {
   double lost_cleared_after_s = std::numeric_limits<double>::quiet_NaN();
 };
 
+// The accuracy figures against the run's reference (scoring/reference_trajectory.hpp) rather than the
+// exact truth: each estimate's error by the same convention with the reference, interpolated at its
+// stamp, in the truth's place (in the reference's vehicle frame, as a real experiment has no other), on
+// the same frames as Metrics' own figures (scored, not settling, not recovering).
+struct ReferenceAccuracy {
+  ReferenceConfig config;  // what was drawn (a label: the scorer is given the poses)
+  double lateral_rmse_m = std::numeric_limits<double>::quiet_NaN();
+  double longitudinal_rmse_m = std::numeric_limits<double>::quiet_NaN();
+  double heading_rmse_deg = std::numeric_limits<double>::quiet_NaN();
+  double position_rmse_m = std::numeric_limits<double>::quiet_NaN();
+  double max_position_error_m = std::numeric_limits<double>::quiet_NaN();  // absolute, as Metrics'
+  double max_lateral_m = std::numeric_limits<double>::quiet_NaN();
+  double max_longitudinal_m = std::numeric_limits<double>::quiet_NaN();
+  double max_heading_deg = std::numeric_limits<double>::quiet_NaN();
+  // The reference's own error against the truth on those frames, by the same convention (RMS): what it
+  // adds to, or takes from, the figures above.
+  double error_lateral_rms_m = std::numeric_limits<double>::quiet_NaN();
+  double error_longitudinal_rms_m = std::numeric_limits<double>::quiet_NaN();
+  double error_heading_rms_deg = std::numeric_limits<double>::quiet_NaN();
+};
+
 struct Metrics {
   std::string method, scenario;
   // The run's realism profile and the knobs the scenario set on top of it (labels, not scored).
@@ -173,6 +195,8 @@ struct Metrics {
   // the run's visibility is not known, as in a replayed log without it).
   double curb_hidden_fraction = std::numeric_limits<double>::quiet_NaN();
   double curb_hidden_fraction_max = std::numeric_limits<double>::quiet_NaN();
+  // Against the run's reference, when it has one (the scenario's `reference`); unset: the truth only.
+  std::optional<ReferenceAccuracy> reference;
   Consistency consistency;
   Integrity integrity;
   std::vector<EventRecovery> recovery;  // one per event given to score(), in time order
@@ -206,11 +230,15 @@ bool recovering(int64_t stamp_ns, const PassThresholds& thresholds, const std::v
 // stamp or the route has fewer than two points. `curb_visibility` (one record per scan, any order)
 // gives the curb occlusion figures; it is not scored against any threshold. `events` (any order;
 // loop/fault_events.hpp's from a scenario) give the recovery figures, by thresholds.recovery's
-// criteria or, unset, its defaults, and, when it is set, the recovery frames.
+// criteria or, unset, its defaults, and, when it is set, the recovery frames. `reference` (the truth's
+// stamps, scoring/reference_trajectory.hpp), when not empty, gives Metrics::reference (its config left
+// default for the caller to label) and, with thresholds.against_reference, the poses the accuracy
+// thresholds are checked against; empty with against_reference is a failure. Throws
+// std::invalid_argument when a non-empty reference's stamps are not the truth's.
 ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateRecord>& estimates, const Path& route,
                 const PassThresholds& thresholds, const std::string& method, const std::string& scenario,
                 const std::vector<FaultEvent>& events = {}, const std::vector<CurbVisibility>& curb_visibility = {},
-                int64_t scan_period_ns = Hdl32eConfig{}.scan_period_ns());
+                int64_t scan_period_ns = Hdl32eConfig{}.scan_period_ns(), const std::vector<TruthPose>& reference = {});
 
 // ---- Its parts, pure as well ----
 

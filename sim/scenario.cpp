@@ -22,6 +22,10 @@ constexpr double kMaxSpeed = 40;            // m/s for any actor
 constexpr double kPathCheckStep = 1.0;      // m between on-road checks
 constexpr double kMaxAlertLimit = 1e4;      // m, as the other distance thresholds of `pass`
 constexpr double kMaxNees = 1e6;            // a mean NEES bound beyond any filter worth gating
+// A reference is centimetres off; a metre (or 10 deg) is no reference but a second localizer to score.
+constexpr double kMaxReferenceSigma_m = 1.0, kMaxReferenceHeadingSigma_deg = 10.0;
+// Below a truth sample's 10 ms every sample's error would be drawn afresh: white, not correlated.
+constexpr double kMinReferenceCorrelation_s = 0.01;
 
 std::vector<Wait> read_waits(const YamlReader& y, const YAML::Node& n, const char* what) {
   std::vector<Wait> out;
@@ -36,6 +40,8 @@ std::vector<Wait> read_waits(const YamlReader& y, const YAML::Node& n, const cha
   std::sort(out.begin(), out.end(), [](const Wait& a, const Wait& b) { return a.at < b.at; });
   return out;
 }
+
+bool read_choice(const YamlReader& y, const YAML::Node& n, const std::string& what, const char* no, const char* yes);
 
 // A `pass` mapping over the values `pass` already holds.
 void read_pass(const YamlReader& y, const YAML::Node& n, PassThresholds& pass) {
@@ -53,6 +59,8 @@ void read_pass(const YamlReader& y, const YAML::Node& n, PassThresholds& pass) {
       .number("alert_limit_longitudinal_m", pass.alert_limit_longitudinal_m, 0.0, kMaxAlertLimit)
       .number("min_mean_nees", pass.min_mean_nees, 0.0, kMaxNees)
       .number("max_mean_nees", pass.max_mean_nees, 0.0, kMaxNees);
+  if (const YAML::Node against = m["against"])
+    pass.against_reference = read_choice(y, against, "against", "truth", "reference");
   if (const YAML::Node r = m["recovery"]) {
     PassThresholds::Recovery recovery = pass.recovery.value_or(PassThresholds::Recovery{});
     YamlMap(y, r, "recovery")
@@ -213,6 +221,21 @@ void read_rtk(const YamlReader& y, const YAML::Node& n, RtkConfig& r) {
       .done();
 }
 
+// `reference`: over the profile's. A knob without a reference to apply it to is a mistake, not a no-op.
+void read_reference(const YamlReader& y, const YAML::Node& n, ReferenceConfig& r) {
+  YamlMap m(y, n, "reference");
+  if (const YAML::Node kind = m["kind"])
+    r.kind = read_choice(y, kind, "reference kind", "none", "rtk") ? ReferenceConfig::Kind::rtk
+                                                                   : ReferenceConfig::Kind::none;
+  m.number("sigma_xy_m", r.sigma_xy_m, 0.0, kMaxReferenceSigma_m)
+      .degrees("heading_sigma_deg", r.heading_sigma_rad, 0.0, kMaxReferenceHeadingSigma_deg)
+      .number("correlation_s", r.correlation_s, kMinReferenceCorrelation_s, kMaxDuration);
+  m.done();
+  if (r.kind == ReferenceConfig::Kind::none)
+    for (const char* key : {"sigma_xy_m", "heading_sigma_deg", "correlation_s"})
+      if (n[key]) y.fail(n[key], std::string(key) + " needs a reference: kind is none (give kind: rtk)");
+}
+
 EgoSpec read_ego(const YamlReader& y, const YAML::Node& n, const VehicleParams& vehicle) {
   YamlMap m(y, n, "ego");
   EgoSpec e;
@@ -338,7 +361,11 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   // The map's survey settings (mapping/mapping_drive.hpp's read_survey_options), read with the map.
   if (const YAML::Node survey = root["survey"]) y.expect_map(survey, "survey");
   if (const YAML::Node loop = root["loop"]) s.closed_loop = read_choice(y, loop, "loop", "open", "closed");
+  s.reference = reference_config_for(s.realism);
+  if (const YAML::Node n = root["reference"]) read_reference(y, n, s.reference);
   read_pass(y, root["pass"], s.pass);
+  if (s.pass.against_reference && s.reference.kind == ReferenceConfig::Kind::none)
+    y.fail(root["pass"]["against"], "pass against the reference, but the scenario has none (reference kind none)");
   YamlMap(y, root["output"], "output").integer("scan_every", s.scan_every, 0, 1000000).done();
   root.done();
   return s;
@@ -429,6 +456,16 @@ void check_on_network(const BuiltPath& built, const region::Paths& area, const s
 
 }  // namespace
 
+ReferenceConfig reference_config_for(Realism realism) {
+  ReferenceConfig r;
+  if (realism == Realism::ideal) r.kind = ReferenceConfig::Kind::none;
+  return r;
+}
+
+const char* reference_kind_name(ReferenceConfig::Kind kind) {
+  return kind == ReferenceConfig::Kind::rtk ? "rtk" : "none";
+}
+
 Scenario load_scenario(const std::string& path, const VehicleParams& vehicle, std::optional<Realism> realism) {
   Scenario s = parse(YamlReader::open(path), vehicle, realism);
   // A world given as a file is found beside the scenario, from whatever folder lidarloop runs in; a
@@ -483,8 +520,8 @@ std::vector<std::string> realism_overrides(const Scenario& scenario) {
   if (!root.IsMap()) return out;
   for (const auto& kv : root) {
     const std::string key = kv.first.Scalar();
-    for (const char* section :
-         {"lidar", "body", "weather", "clocks", "mount_error", "can", "gps", "rtk", "survey", "world_changes"})
+    for (const char* section : {"lidar", "body", "weather", "clocks", "mount_error", "can", "gps", "rtk", "survey",
+                                "world_changes", "reference"})
       if (key == section) list_scalars(kv.second, key, out);
   }
   return out;

@@ -133,10 +133,12 @@ int run_replay(const Args& args) {
   const ScoredRun scored = score_and_write(out, name, scenario, resolved.ego_route, truth, method_label(params),
                                            estimates, nullptr, map, curb_visibility, failure);
   std::cout << comparison_markdown({scored.metrics});
+  if (const std::string table = reference_markdown({scored.metrics}); !table.empty()) std::cout << "\n" << table;
   std::printf("\nlog        %s (%zu scans, seed %llu, recorded with %s)\n", log.c_str(), scans,
               (unsigned long long)scenario.seed, recorded_method.empty() ? "no localizer" : recorded_method.c_str());
   std::printf("latency    %s\n", latency_text(scored.metrics).c_str());
   std::printf("curbs      %s\n", curb_occlusion_text(scored.metrics).c_str());
+  std::cout << reference_lines(scored.metrics);
   if (method == recorded_method) compare_statuses(log, recorded_statuses, estimates);
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(

@@ -55,6 +55,21 @@ void print_realism(const Scenario& s, bool mount = true) {
       rpy.x(), rpy.y(), rpy.z(), xyz.x(), xyz.y(), xyz.z());
 }
 
+// The accuracy against the truth and against the reference side by side, after the score table;
+// nothing when no run has a reference, so such a run prints what it always did.
+void print_reference_table(const std::vector<Metrics>& metrics) {
+  const std::string table = reference_markdown(metrics);
+  if (!table.empty()) std::cout << "\n" << table;
+}
+
+// The paper's table again with ours against the reference, as the paper's own figures were measured
+// against its RTK GPS; empty when no run has a reference.
+std::string paper_reference_markdown(PaperTable table, const std::vector<Metrics>& metrics) {
+  const std::vector<MethodOverSeeds> ours = summarise_over_seeds(metrics, true);
+  if (ours.empty()) return "";
+  return "\nours against the reference (the paper's against its RTK GPS):\n" + paper_comparison_markdown(table, ours);
+}
+
 struct Progress {
   bool terminal = isatty(STDOUT_FILENO) != 0;
   std::string what;
@@ -120,6 +135,7 @@ int run_run(const Args& args) {
                                            trace.estimates, &trace.worst, map, r.curb_visibility, trace.failure);
   const Metrics& m = scored.metrics;
   std::cout << comparison_markdown({m});
+  print_reference_table({m});
   std::printf("\nscenario   %s (seed %llu, %s loop), %.1f s simulated in %.1f s wall (%.1fx real time, %d thread(s))\n",
               s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.closed_loop ? "closed" : "open",
               s.scenario.duration_s, r.wall_s, s.scenario.duration_s / r.wall_s, threads);
@@ -140,6 +156,7 @@ int run_run(const Args& args) {
   }
   std::printf("curbs      %s\n", curb_occlusion_text(m).c_str());
   std::cout << integrity_lines(m);
+  std::cout << reference_lines(m);
   for (const auto& f : m.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
       "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
@@ -211,7 +228,9 @@ std::vector<Metrics> compare_once(const LoadedScenario& s, const std::vector<std
                           .metrics);
   write_junit(out + "/junit.xml", metrics);
   write_comparison_csv(out + "/comparison.csv", metrics);
-  write_text_file(out + "/comparison.md", comparison_markdown(metrics));
+  const std::string reference_table = reference_markdown(metrics);
+  write_text_file(out + "/comparison.md",
+                  comparison_markdown(metrics) + (reference_table.empty() ? "" : "\n" + reference_table));
   for (const auto& trace : r.methods)
     if (!trace.failure.empty())
       throw InputError(trace.failure + " (the comparison's results are in " + out + "/, " + trace.method + " failed)");
@@ -242,13 +261,18 @@ int run_compare(const Args& args) {
     size_t scans = 0;
     const std::vector<Metrics> metrics = compare_once(s, methods, threads, out, scans, args);
     std::cout << comparison_markdown(metrics);
-    if (paper) std::cout << "\n" << paper_comparison_markdown(*paper, summarise_over_seeds(metrics));
+    print_reference_table(metrics);
+    if (paper)
+      std::cout << "\n"
+                << paper_comparison_markdown(*paper, summarise_over_seeds(metrics))
+                << paper_reference_markdown(*paper, metrics);
     std::printf("\nscenario   %s (seed %llu), %.1f s, %zu scans, %zu methods on the same streams\n",
                 s.scenario.file.c_str(), (unsigned long long)s.scenario.seed, s.scenario.duration_s, scans,
                 metrics.size());
     print_realism(s.scenario);
     if (!metrics.empty()) std::printf("curbs      %s\n", curb_occlusion_text(metrics.front()).c_str());  // one drive
     for (const Metrics& m : metrics) std::cout << integrity_lines(m, m.method);
+    for (const Metrics& m : metrics) std::cout << reference_lines(m, m.method);
     std::printf("files      %s/ (comparison.md, comparison.csv, junit.xml, <method>/...)\n", out.c_str());
     return expect ? expect_best(metrics, *expect) : 0;
   }
@@ -271,8 +295,8 @@ int run_compare(const Args& args) {
     if (expect && expect_best(metrics, *expect) != 0) status = 1;
   }
   const std::vector<MethodOverSeeds> summary = summarise_over_seeds(all);
-  const std::string table = paper ? paper_comparison_markdown(*paper, summary)
-                                  : paper_comparison_markdown(PaperTable::dynamic_campus, summary);
+  const PaperTable beside = paper.value_or(PaperTable::dynamic_campus);
+  const std::string table = paper_comparison_markdown(beside, summary) + paper_reference_markdown(beside, all);
   write_comparison_csv(out + "/comparison.csv", all);
   write_text_file(out + "/seeds.md", table);
   std::cout << "\n" << table;

@@ -98,6 +98,7 @@ int run_score(const Args& args) {
   const Metrics& m = scored.metrics;
 
   std::cout << comparison_markdown({m});
+  if (const std::string table = reference_markdown({m}); !table.empty()) std::cout << "\n" << table;
   std::printf("\nlog        %s (seed %llu, recorded with %s)\n", log.c_str(), (unsigned long long)scenario.seed,
               recorded.run.method.empty() ? "no localizer" : recorded.run.method.c_str());
   std::printf("estimate   %s: %s%s, %zu poses, %zu scored, %zu settling, %zu outside the truth's time range\n",
@@ -113,6 +114,7 @@ int run_score(const Args& args) {
   std::printf("latency    not known from a file: null in metrics.json\n");
   std::printf("curbs      %s\n", curb_occlusion_text(m).c_str());
   std::cout << integrity_lines(m);
+  std::cout << reference_lines(m);
   for (const auto& f : m.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
       "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "

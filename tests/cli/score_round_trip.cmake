@@ -56,6 +56,13 @@ lidarloop(0 "result     PASS" run ${SCENARIO} --method proposed --duration 6 --r
 lidarloop(0 "exported" export ${log} --tum ${WORKDIR}/est.tum)
 lidarloop(0 "result     PASS" score ${log} --estimate ${WORKDIR}/est.tum --method proposed --out ${WORKDIR}/tum)
 expect_same_metrics(${WORKDIR}/live/metrics.json ${WORKDIR}/tum/metrics.json "TUM")
+# The scoring reference is drawn from the truth and the seed where the run is scored: `score` of the
+# log draws the live run's, byte for byte.
+file(SHA256 ${WORKDIR}/live/reference.tum live_reference)
+file(SHA256 ${WORKDIR}/tum/reference.tum scored_reference)
+if(NOT live_reference STREQUAL scored_reference)
+  message(FATAL_ERROR "reference.tum of score differs from the live run's")
+endif()
 lidarloop(0 "MCAP /localizer/odometry (nav_msgs/msg/Odometry)" score ${log} --estimate ${log}
           --topic /localizer/odometry --method proposed --out ${WORKDIR}/mcap)
 expect_same_metrics(${WORKDIR}/live/metrics.json ${WORKDIR}/mcap/metrics.json "MCAP")

@@ -229,6 +229,51 @@ TEST_F(ScenarioOnCampus, PathsOffTheRoadNetworkAreRejected) {
   expect_resolve_error(edit("position: [303, 120]", "position: [5000, 120]"), "18:5", "outside the world");
 }
 
+// `reference`: the profile's RTK reference (none under ideal), each knob over it, strictly read; and
+// `pass.against`, which needs one.
+TEST(Scenario, ReferenceIsTheProfilesUnlessTheScenarioSetsIt) {
+  const std::string base = "world: campus\nduration_s: 20\nego: {route: {road: loop}}\n";
+  const Scenario typical = parse_scenario(base, "typical.yaml");
+  EXPECT_EQ(typical.reference.kind, ReferenceConfig::Kind::rtk);
+  EXPECT_EQ(typical.reference.sigma_xy_m, kRtkReferenceSigma_m);
+  EXPECT_DOUBLE_EQ(typical.reference.heading_sigma_rad, kRtkReferenceHeadingSigma_deg * kDeg);
+  EXPECT_EQ(typical.reference.correlation_s, kRtkReferenceCorrelation_s);
+  EXPECT_FALSE(typical.pass.against_reference);
+  EXPECT_EQ(parse_scenario(base, "harsh.yaml", {}, Realism::harsh).reference.kind, ReferenceConfig::Kind::rtk);
+  EXPECT_EQ(parse_scenario(base, "ideal.yaml", {}, Realism::ideal).reference.kind, ReferenceConfig::Kind::none);
+
+  const Scenario set = parse_scenario(base +
+                                          "reference: {kind: rtk, sigma_xy_m: 0.02, heading_sigma_deg: 0.05, "
+                                          "correlation_s: 60}\npass: {against: reference}\n",
+                                      "set.yaml", {}, Realism::ideal);
+  EXPECT_EQ(set.reference.kind, ReferenceConfig::Kind::rtk);
+  EXPECT_EQ(set.reference.sigma_xy_m, 0.02);
+  EXPECT_DOUBLE_EQ(set.reference.heading_sigma_rad, 0.05 * kDeg);
+  EXPECT_EQ(set.reference.correlation_s, 60);
+  EXPECT_TRUE(set.pass.against_reference);
+  const std::vector<std::string> overrides = {"reference.kind = rtk", "reference.sigma_xy_m = 0.02",
+                                              "reference.heading_sigma_deg = 0.05", "reference.correlation_s = 60"};
+  EXPECT_EQ(realism_overrides(set), overrides);
+  EXPECT_EQ(parse_scenario(base + "reference: {kind: none}\n", "none.yaml").reference.kind,
+            ReferenceConfig::Kind::none);
+
+  const std::vector<Malformed> cases = {
+      {"unknown reference key", base + "reference: {sigma_m: 0.03}\n", "4:13", "unknown key 'sigma_m'"},
+      {"unknown reference kind", base + "reference: {kind: gps}\n", "4:19", "reference kind must be none or rtk"},
+      {"negative sigma", base + "reference: {sigma_xy_m: -0.01}\n", "4:25", "sigma_xy_m = -0.01 is out of range"},
+      {"heading not a number", base + "reference: {heading_sigma_deg: small}\n", "4:32",
+       "heading_sigma_deg must be a finite number"},
+      {"zero correlation", base + "reference: {correlation_s: 0}\n", "4:28", "correlation_s = 0 is out of range"},
+      {"a knob without a reference", base + "reference: {kind: none, sigma_xy_m: 0.03}\n", "4:37",
+       "sigma_xy_m needs a reference: kind is none"},
+      {"not a mapping", base + "reference: rtk\n", "4:12", "reference"},
+      {"bad against", base + "pass: {against: gps}\n", "4:17", "against must be truth or reference"},
+      {"against without a reference", base + "reference: {kind: none}\npass: {against: reference}\n", "5:17",
+       "pass against the reference, but the scenario has none"},
+  };
+  expect_rejected(cases);
+}
+
 // Thresholds given apart from a scenario (lidarloop score): a file with a `pass:` mapping and
 // KEY=VALUE arguments, each over what came before and as strictly checked as a scenario's.
 TEST(Scenario, PassThresholdsFromAFileAndFromArguments) {
