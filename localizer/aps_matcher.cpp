@@ -446,6 +446,25 @@ bool aps_peak_on_edge(const std::vector<double>& log_p, const ApsSearchWindow& w
   return (window.nx > 0 && (i == 0 || i == ox - 1)) || (window.ny > 0 && (j == 0 || j == oy - 1));
 }
 
+double aps_along_margin(const std::vector<double>& log_p, const ApsSearchWindow& window, double separation_m,
+                        double prior_sigma_m) {
+  const int ox = window.offsets_x(), oy = window.offsets_y();
+  std::vector<double> along(size_t(ox), -std::numeric_limits<double>::infinity());
+  for (int j = 0; j < oy; ++j)
+    for (int i = 0; i < ox; ++i)
+      along[size_t(i)] = std::max(along[size_t(i)], log_p[size_t(j) * size_t(ox) + size_t(i)]);
+  for (int i = 0; i < ox; ++i) along[size_t(i)] -= 0.5 * std::pow(window.offset(i, 0).x() / prior_sigma_m, 2);
+  const int best = int(std::max_element(along.begin(), along.end()) - along.begin());
+  auto is_peak = [&](int i) {
+    return (i == 0 || along[size_t(i)] >= along[size_t(i - 1)]) &&
+           (i == ox - 1 || along[size_t(i)] >= along[size_t(i + 1)]);
+  };
+  double other = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < ox; ++i)
+    if (std::abs(i - best) * window.step_m > separation_m && is_peak(i)) other = std::max(other, along[size_t(i)]);
+  return along[size_t(best)] - other;
+}
+
 OffsetMoments aps_offset_moments(const std::vector<double>& log_p, const ApsSearchWindow& window) {
   // Relative to the best offset before exponentiating: the raw sums are thousands, exp() would be 0.
   const double best = *std::max_element(log_p.begin(), log_p.end());
@@ -494,6 +513,8 @@ ApsResult aps_match(const IntensityGrid& S, IntensityMap& map, const ApsParams& 
   const OffsetMoments moments = aps_offset_moments(log_p, window);                         // Eq. 15-16
   result.ok = true;
   result.peak_on_edge = aps_peak_on_edge(log_p, window);
+  result.along_margin =
+      aps_along_margin(log_p, window, params.distinct_separation_m, params.prior_longitudinal_sigma_m);
   result.offset_vehicle = moments.mean;
   result.position = origin + R * moments.mean;  // Eq. 17-18, the offset rotated from the vehicle frame
   result.covariance = R * moments.covariance * R.transpose();

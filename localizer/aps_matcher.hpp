@@ -5,6 +5,7 @@
 // offset of a small search window gets a probability (Eq. 14), and the centre of mass of that
 // distribution is the position estimate (Eq. 15-18).
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -128,6 +129,13 @@ struct ApsParams {
   // denominator vanish and decide the whole product.
   double min_sigma = 1.0;
   int min_cells = 50;  // fewer usable cells than this: no estimate (ok = false)
+  // Two peaks of the distribution along the road closer than this are one (m): the wide search's
+  // distinct_separation_m (wide_search.hpp), below the 3 m and more at which dashes repeat.
+  double distinct_separation_m = 1.5;
+  // The prior's doubt along the road (1 sigma, m), counted in ApsResult::along_margin: the window is
+  // centred on the prior, and an offset x along the road is exp(-x^2 / 2 sigma^2) less likely before
+  // the paint is seen. Infinite: not counted.
+  double prior_longitudinal_sigma_m = std::numeric_limits<double>::infinity();
 };
 
 struct ApsResult {
@@ -152,6 +160,11 @@ struct ApsResult {
   // The most probable offset lies on the window's border: the true one may well be outside, and the
   // centroid is then pulled towards the middle of a window that does not contain it.
   bool peak_on_edge = false;
+  // How far the best offset along the road beats the best other peak along it (aps_along_margin): Eq.
+  // 14's log P with the prior along the road. Dashed lines repeat, and a stretch of road with nothing but lines gives a
+  // distribution of noise whose highest spike is still narrow; only the margin tells them from a true peak. +inf when
+  // no other peak lies in the window.
+  double along_margin = std::numeric_limits<double>::infinity();
 };
 
 // APS over the window of offsets around S.pose. A cell of S takes part only if S_n > n_e and the map
@@ -189,6 +202,14 @@ ApsSearchWindow aps_search_window(const ApsParams& params, double cell_m);
 // Eq. 14 in logs, offset by offset: log P = -alpha / 2 * (the offset's sum of squared z-scores
 // (m_r - s_r)^2 / (m_sigma + s_sigma)^2). Up to a constant, which the moments do not need.
 std::vector<double> aps_log_probabilities(const std::vector<float>& z_score_sums, double alpha);
+
+// The margin along the road: over each longitudinal offset's best lateral one, Eq. 14's log P plus the
+// log of a Gaussian prior of prior_sigma_m along the road centred on the window (the posterior, up to a
+// constant), of the best minus that of the best local peak farther than separation_m from it along the
+// road (a border offset counts as a peak if it is above its one neighbour: the rising flank of a peak
+// beyond the window). +inf without one. log_p: row-major, offsets_x() per row.
+double aps_along_margin(const std::vector<double>& log_p, const ApsSearchWindow& window, double separation_m,
+                        double prior_sigma_m = std::numeric_limits<double>::infinity());
 
 // Whether the most probable offset lies on the window's border (along an axis with more than one
 // offset). log_p: row-major, offsets_x() per row.

@@ -144,6 +144,8 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   top.number("aps_covariance_scale", p.aps_covariance_scale, 1e-3, 1e3);
   top.boolean("aps_longitudinal_only_with_curbs", p.aps_longitudinal_only_with_curbs);
   top.number("aps_max_spread_ratio", p.aps_max_spread_ratio, 0.0, 10.0);
+  top.number("aps_min_along_margin", p.aps_min_along_margin, 0.0, 1e9);
+  top.number("aps_grown_within_sigmas", p.aps_grown_within_sigmas, 0.0, 100.0);
   top.number("icp_max_correspondence_m", p.icp_max_correspondence_m, 0.1, 100.0);
   top.number("aps_max_lateral_range_m", p.aps_max_lateral_range_m, 0.0, 50.0);
   top.number("aps_max_longitudinal_range_m", p.aps_max_longitudinal_range_m, 0.0, 50.0);
@@ -275,6 +277,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
       .integer("min_count", p.aps.min_count, 0, 100000)
       .number("min_sigma", p.aps.min_sigma, 1e-6, 255.0)
       .integer("min_cells", p.aps.min_cells, 0, 1000000)
+      .number("distinct_separation_m", p.aps.distinct_separation_m, 0.0, 20.0)
       .done();
   YamlMap(y, top["vehicle"], "vehicle")
       .number("cornering_stiffness_front", p.vehicle.cornering_stiffness_front, 1e3, 1e6)

@@ -404,6 +404,69 @@ TEST(ApsSteps, APeakOnTheBorderIsOnTheEdgeOnlyAlongAnAxisThatIsSearched) {
   EXPECT_FALSE(aps_peak_on_edge(log_p, row));
 }
 
+// Along a +-3 m x +-0.2 m window: the best offset at 0 and another peak 2 m ahead (on another lateral
+// row), 7 below it; the flanks of the best within 1.5 m do not count.
+TEST(ApsSteps, TheAlongMarginIsTheGapToTheBestOtherPeakAlongTheRoad) {
+  ApsParams p;
+  p.longitudinal_range_m = 3.0;
+  p.lateral_range_m = 0.2;
+  const ApsSearchWindow w = aps_search_window(p, kResolution);
+  const size_t n = size_t(w.offsets_x() * w.offsets_y());
+  auto at = [&](int i, int j) { return size_t(j * w.offsets_x() + i); };
+  auto profile = [&](auto height) {  // height(x) along the road, the same on the middle row; lower on the others
+    std::vector<double> log_p(n);
+    for (int j = 0; j < w.offsets_y(); ++j)
+      for (int i = 0; i < w.offsets_x(); ++i) log_p[at(i, j)] = height(w.offset(i, j).x()) - (j == 1 ? 0.0 : 50.0);
+    return log_p;
+  };
+  const auto one_peak = profile([](double x) { return -20 * x * x; });
+  EXPECT_TRUE(std::isinf(aps_along_margin(one_peak, w, p.distinct_separation_m)));
+
+  auto two_peaks = one_peak;
+  const int ahead = w.nx + 10;   // +2 m
+  two_peaks[at(ahead, 0)] = -7;  // above its neighbours on every row
+  EXPECT_NEAR(aps_along_margin(two_peaks, w, p.distinct_separation_m), 7.0, 1e-12);
+  // Closer than the separation, it is part of the best peak.
+  EXPECT_TRUE(std::isinf(aps_along_margin(two_peaks, w, 2.5)));
+
+  // Rising towards the window's border: a peak beyond it may be higher still, so the border counts.
+  const auto rising = profile([](double x) { return x < 2.5 ? -20 * x * x : -40 + 10 * (x - 2.5); });
+  EXPECT_NEAR(aps_along_margin(rising, w, p.distinct_separation_m), 40 - 5, 1e-9);
+}
+
+// A centre line dashed every 3 m (1.5 m paint, 1.5 m gap) the whole length of the road, and the same
+// with one stop line across it: seen by a scan, the dashes fit as well a period ahead or behind, so
+// APS's best offset along the road beats the next peak only by noise; the stop line is one of a kind.
+bool dashed_centre_line(const Eigen::Vector2d& p) { return std::fabs(p.y()) < 0.075 && std::fmod(p.x(), 3.0) < 1.5; }
+bool dashes_and_a_stop_line(const Eigen::Vector2d& p) {
+  return dashed_centre_line(p) || (p.x() >= 31.0 && p.x() < 31.5 && p.y() > -3.5 && p.y() < 0);
+}
+
+TEST(ApsAlongMargin, DashesRepeatingAlongTheRoadLeaveNoMarginAStopLineDoes) {
+  const LocalizerParams defaults;
+  const IntensityGridParams g;
+  ApsParams params;  // a window grown to a cold start's doubt: +-6 m along the road
+  params.longitudinal_range_m = 6.0;
+  const Eigen::Vector2d error(1.0, 0.0);
+  const Pose2d truth{30.0, 0.0, 0.0};
+  double margins[2] = {0, 0};
+  int k = 0;
+  for (Pattern pattern : {dashed_centre_line, dashes_and_a_stop_line}) {
+    const std::string dir = build_map(pattern, "margin_" + std::to_string(k), 7);
+    IntensityMap map(dir);
+    const Scan scan = scan_at(pattern, truth, g, 8);
+    const ApsResult r =
+        aps_match(build_intensity_grid(scan.points, scan.intensities, prior_from(truth, error), g), map, params);
+    ASSERT_TRUE(r.ok);
+    margins[k++] = r.along_margin;
+    fs::remove_all(dir);
+  }
+  std::printf("[ aps ] along margin: dashes %.1f, dashes and a stop line %.1f (Eq. 14 log P)\n", margins[0],
+              margins[1]);
+  EXPECT_LT(margins[0], defaults.aps_min_along_margin);
+  EXPECT_GT(margins[1], defaults.relocalization.min_aps_margin);
+}
+
 TEST_F(Aps, GridCellsMustBeTheMapsCells) {
   IntensityMap map(*crosswalk_dir_);
   IntensityGridParams g;

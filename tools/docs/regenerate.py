@@ -41,6 +41,13 @@ SUITE = ["static_campus", "dynamic_campus", "bus_occlusion", "straight_road", "i
          "closed_loop_campus", "changed_world", "kidnap", "gps_jump_parked", "cold_start_parked"]
 PAPER_SCENARIOS = [("static", "static_campus", "Table II"), ("dynamic", "dynamic_campus", "Table III")]
 GICP_SCENARIOS = ["static_campus", "dynamic_campus", "bus_occlusion"]
+# Integrity over many seeds: the scenarios, the seeds (LIDARLOOP_INTEGRITY_SEEDS, a compare --seeds list)
+# and the methods (LIDARLOOP_INTEGRITY_METHODS; by default the paper's: gicp, beyond the paper and the
+# slowest, is left out).
+INTEGRITY_SCENARIOS = ["static_campus", "dynamic_campus", "closed_loop_campus", "intersections", "cold_start_parked",
+                       "kidnap", "gps_jump_parked"]
+INTEGRITY_SEEDS = os.environ.get("LIDARLOOP_INTEGRITY_SEEDS", "1-20")
+INTEGRITY_METHODS = os.environ.get("LIDARLOOP_INTEGRITY_METHODS", "gps,icp,icp-obs,m-icp,fmt,intensity,proposed")
 PICTURE_LIMIT_BYTES = 200 * 1024
 
 
@@ -236,6 +243,69 @@ def target_suite(r, commands):
             picture(os.path.join(out, "worst_frame.png"), "docs/images/worst_frame.png")
             picture(os.path.join(out, "errors.png"), "docs/images/errors.png")
     return {"suite": "\n".join(lines) + "\n"}
+
+
+def misleading_stretches(errors_csv):
+    """The longest stretch of consecutive misleading frames in a run's errors.csv (s, from the first such
+    frame's stamp to the next frame's), and how many frames were misleading."""
+    longest, count, start, previous_bad = 0.0, 0, None, False
+    with open(errors_csv, newline="") as f:
+        for row in csv.DictReader(f):
+            t, bad = float(row["t_s"]), row["misleading"] == "1"
+            count += bad
+            if bad and not previous_bad:
+                start = t
+            if previous_bad and not bad:
+                longest = max(longest, t - start)
+            previous_bad = bad
+    if previous_bad:
+        longest = max(longest, t - start)
+    return longest, count
+
+
+def target_integrity(r, commands):
+    """Every method of the paper over many seeds of the scenarios that test integrity: misleading frames,
+    the longest misleading stretch, mean NEES per axis and availability."""
+    lines = ["| scenario | method | runs | misleading frames | runs misleading > 1 s (longest s) | "
+             "mean NEES lateral / longitudinal / heading | availability | passed |",
+             "|---|---|---:|---:|---:|---|---:|---:|"]
+    totals = {}
+    for scenario in INTEGRITY_SCENARIOS:
+        out = fresh(os.path.join(WORK, "integrity", scenario))
+        # Exit 1: a method missed a threshold on some seed, a result for the table.
+        _, _, _, shown = r.run(["lidarloop", "compare", f"scenarios/{scenario}.yaml", "--seeds", INTEGRITY_SEEDS,
+                                "--methods", INTEGRITY_METHODS, "--out", out], ok=(0, 1))
+        commands.append(shown)
+        seeds = sorted(d for d in os.listdir(out) if d.startswith("seed_"))
+        for method in INTEGRITY_METHODS.split(","):
+            runs, misleading, bounded, long_runs, longest, passed = 0, 0, 0, 0, 0.0, 0
+            nees, availability = {"lateral": [], "longitudinal": [], "heading": []}, []
+            for seed in seeds:
+                m = json.loads(read(os.path.join(out, seed, method, "metrics.json")))
+                stretch, _ = misleading_stretches(os.path.join(out, seed, method, "errors.csv"))
+                runs += 1
+                passed += bool(m["pass"])
+                misleading += m["integrity"]["misleading_frames"]
+                bounded += m["integrity"]["frames_with_bounds"]
+                long_runs += stretch > 1.0
+                longest = max(longest, stretch)
+                availability.append(m["integrity"]["availability"] or 0.0)
+                for axis in nees:
+                    value = m["consistency"][f"mean_nees_{axis}"]
+                    if value is not None:
+                        nees[axis].append(value)
+            t = totals.setdefault(method, [0, 0])
+            t[0] += misleading
+            t[1] += bounded
+            share = f"{misleading} of {bounded} ({100.0 * misleading / bounded:.2f} %)" if bounded else "no bounds"
+            mean = lambda v: num(sum(v) / len(v), "{:.2f}") if v else "n/a"
+            lines.append(f"| `{scenario}` | {method} | {runs} | {share} | {long_runs} ({longest:.1f}) | "
+                         f"{mean(nees['lateral'])} / {mean(nees['longitudinal'])} / {mean(nees['heading'])} | "
+                         f"{100.0 * sum(availability) / len(availability):.1f} % | {passed} of {runs} |")
+    summary = ", ".join(f"{method} {t[0]} of {t[1]} ({100.0 * t[0] / t[1]:.2f} %)" if t[1] else f"{method} no bounds"
+                        for method, t in totals.items())
+    return {"integrity": f"Seeds {INTEGRITY_SEEDS}. Misleading frames over every scenario and seed: {summary}.\n\n"
+                         + "\n".join(lines) + "\n"}
 
 
 def scenario_seed(name):
@@ -479,6 +549,9 @@ TARGETS = {
                   "CARLA's Town01 and esmini's fabriksgatan: each world, HD map, scenario open and closed, compare"),
     "logs": (target_logs, {"log-sizes": "docs/logs.md"},
              "a minute of static_campus recorded as clouds, clouds and packets, packets only; the last replayed"),
+    "integrity": (target_integrity, {"integrity": "docs/integrity.md"},
+                  "the paper's methods (LIDARLOOP_INTEGRITY_METHODS) over seeds 1-20 (LIDARLOOP_INTEGRITY_SEEDS) of "
+                  "seven scenarios: misleading frames, the longest misleading stretch, NEES, availability"),
     "sweep": (target_sweep, {"sweep": "docs/sweeps.md"},
               "a 16-run bus occlusion sweep (tools/docs/bus_occlusion_docs.yaml) and its plots"),
 }
