@@ -179,5 +179,25 @@ TEST(HdMap, AMapOfAnotherWorldOrMismatchedLayersIsAnError) {
   EXPECT_THROW(open_hd_map(no_curbs, "campus"), InputError);
 }
 
+TEST(HdMap, ACurbFarOutsideTheIntensityTilesIsAnError) {
+  // The tiles are 3.2 m and cover x in [-6.4, 6.4), y in [0, 3.2): a curb one tile beyond them is kept,
+  // one running 111 km north (a degree of latitude, as a corrupt file had it) is refused before it is
+  // densified into millions of points.
+  const Geodetic origin{31.28, 121.21, 0};
+  const std::string dir = saved_map("far_curb", "campus", origin);
+  write_curb_map(dir + "/curbs.geojson", CurbMap{origin, "campus", {{{-9, 6}, {9, 6}}}, {}});
+  EXPECT_NEAR(open_hd_map(dir, "campus").curbs.distance({0, 0}), 6.0, 1e-6);
+  write_curb_map(dir + "/curbs.geojson", CurbMap{origin, "campus", {{{-5, 4}, {5, 111000}}}, {}});
+  try {
+    open_hd_map(dir, "campus");
+    ADD_FAILURE() << "accepted a curb 111 km outside the map";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + "/curbs.geojson: feature 0 has a point at (5.0, 111000.0) m"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("outside the intensity layer's tiles"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace lidarloop
