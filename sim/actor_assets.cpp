@@ -16,6 +16,22 @@ std::optional<ActorType> actor_type_from_name(const std::string& name) {
 
 std::string actor_type_name(ActorType type) { return kNames[static_cast<size_t>(type)]; }
 
+ActorFootprint actor_footprint(ActorType type) {
+  switch (type) {
+    case ActorType::car:
+      return {4.612, 1.85};
+    case ActorType::bus:
+      return {12.012, 2.562};
+    case ActorType::truck:
+      return {8.512, 2.512};
+    case ActorType::pedestrian:
+      return {0.766, 0.501};
+    case ActorType::cyclist:
+      return {1.75, 0.6};
+  }
+  return {0, 0};
+}
+
 std::string actor_type_names() {
   std::string out;
   for (const char* n : kNames) out += (out.empty() ? "" : ", ") + std::string(n);

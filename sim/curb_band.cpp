@@ -20,33 +20,6 @@ constexpr int kVariationWaves = 3;
 
 Eigen::Vector2d right_normal(const Eigen::Vector2d& t) { return {t.y(), -t.x()}; }
 
-struct Cut {
-  double from, to;  // arc length along the road
-  CurbCut kind;
-};
-
-// Every cut of one side of one road, in arc length along the road's centreline.
-std::vector<Cut> cuts_of(const WorldDescription& d, int road, RoadSide side) {
-  const RoadSpec& r = d.roads[size_t(road)];
-  std::vector<Cut> out;
-  for (const auto& c : d.curb_cuts)
-    if (c.road == r.name && c.side == side) out.push_back({c.at - c.length / 2, c.at + c.length / 2, c.kind});
-  for (const auto& c : d.crosswalks)
-    if (d.geometry.crosswalk_ramps && c.road == r.name)
-      out.push_back({c.at - c.width / 2, c.at + c.width / 2, CurbCut::ramp});
-  if (r.driveway_spacing > 0) {
-    const double length = polyline_length(r.centreline);
-    for (double s = r.driveway_spacing / 2; s + r.driveway_width / 2 < length; s += r.driveway_spacing) {
-      const Cut cut{s - r.driveway_width / 2, s + r.driveway_width / 2, CurbCut::driveway};
-      // A driveway does not run into a crosswalk's ramp or another cut.
-      bool clear = true;
-      for (const Cut& other : out) clear = clear && (cut.to < other.from || cut.from > other.to);
-      if (clear) out.push_back(cut);
-    }
-  }
-  return out;
-}
-
 // Smooth variation of the curb reveal along a road: a few long sinusoids, within +-amplitude.
 struct RevealVariation {
   struct Wave {
@@ -69,6 +42,27 @@ struct RevealVariation {
 };
 
 }  // namespace
+
+std::vector<CurbCutSpan> curb_cuts_of(const WorldDescription& d, int road, RoadSide side) {
+  const RoadSpec& r = d.roads[size_t(road)];
+  std::vector<CurbCutSpan> out;
+  for (const auto& c : d.curb_cuts)
+    if (c.road == r.name && c.side == side) out.push_back({c.at - c.length / 2, c.at + c.length / 2, c.kind});
+  for (const auto& c : d.crosswalks)
+    if (d.geometry.crosswalk_ramps && c.road == r.name)
+      out.push_back({c.at - c.width / 2, c.at + c.width / 2, CurbCut::ramp});
+  if (r.driveway_spacing > 0) {
+    const double length = polyline_length(r.centreline);
+    for (double s = r.driveway_spacing / 2; s + r.driveway_width / 2 < length; s += r.driveway_spacing) {
+      const CurbCutSpan cut{s - r.driveway_width / 2, s + r.driveway_width / 2, CurbCut::driveway};
+      // A driveway does not run into a crosswalk's ramp or another cut.
+      bool clear = true;
+      for (const CurbCutSpan& other : out) clear = clear && (cut.to < other.from || cut.from > other.to);
+      if (clear) out.push_back(cut);
+    }
+  }
+  return out;
+}
 
 // Face shapes. Vertical: AASHTO's vertical curb. Sloped: a 1:1 batter (an assumption within AASHTO's
 // mountable curbs, which only bound the height). Rolled: an S-shaped face over twice its height, as
@@ -128,10 +122,10 @@ CurbBandWidths curb_band_widths(const WorldDescription& d) {
 std::vector<std::vector<CurbStation>> curb_stations(const std::vector<Polyline2d>& rings, const WorldDescription& d,
                                                     const RoadSurface& surface, double step) {
   std::vector<RevealVariation> variation;
-  std::vector<std::array<std::vector<Cut>, 2>> cuts;  // per road: right, left
+  std::vector<std::array<std::vector<CurbCutSpan>, 2>> cuts;  // per road: right, left
   for (size_t r = 0; r < d.roads.size(); ++r) {
     variation.emplace_back(d.geometry.roughness_seed * d.roads.size() + r, d.roads[r].curb_height_variation);
-    cuts.push_back({cuts_of(d, int(r), RoadSide::right), cuts_of(d, int(r), RoadSide::left)});
+    cuts.push_back({curb_cuts_of(d, int(r), RoadSide::right), curb_cuts_of(d, int(r), RoadSide::left)});
   }
   std::vector<std::vector<CurbStation>> out;
   for (const Polyline2d& closed : rings) {
@@ -165,7 +159,7 @@ std::vector<std::vector<CurbStation>> curb_stations(const std::vector<Polyline2d
       c.terrain_z = surface.terrain(c.point);
       if (std::abs(at.distance - road.width / 2) < kOnEdgeTolerance) {
         const double flare = c.nominal_height / d.geometry.flare_slope;
-        for (const Cut& cut : cuts[size_t(at.road)][at.lateral > 0 ? 1 : 0]) {
+        for (const CurbCutSpan& cut : cuts[size_t(at.road)][at.lateral > 0 ? 1 : 0]) {
           const double outside = std::max({cut.from - at.s, at.s - cut.to, 0.0});
           c.height = std::min(c.height, c.nominal_height * std::min(1.0, outside / flare));
           if (outside == 0) c.cut = cut.kind;

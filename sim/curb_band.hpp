@@ -23,6 +23,15 @@ double face_run(CurbProfile profile, double height);
 double face_rise(CurbProfile profile, double u);
 
 const char* curb_profile_name(CurbProfile profile);
+
+// A stretch of one side of a road where the curb is cut, in arc length along the road's centreline.
+struct CurbCutSpan {
+  double from, to;
+  CurbCut kind;
+};
+// Every cut of one side (left or right) of road number `road`: those the world file lists, a ramp at
+// each crosswalk (when the world builds them), and driveways at the road's spacing clear of the others.
+std::vector<CurbCutSpan> curb_cuts_of(const WorldDescription& d, int road, RoadSide side);
 const char* curb_cut_name(CurbCut cut);
 
 // One cross-section of the band, at a point of a curb line.

@@ -338,6 +338,7 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
     y.expect_sequence(t, "traffic");
     for (const auto& a : t) s.traffic.push_back(read_actor(y, a));
   }
+  if (const YAML::Node n = root["street"]) read_street_use(y, n, s.street);
   if (const YAML::Node faults = root["faults"]) {
     y.expect_sequence(faults, "faults");
     for (const auto& f : faults) s.kidnaps.push_back(read_fault(y, f, s.duration_s));
@@ -555,6 +556,13 @@ ResolvedScenario resolve_scenario(const Scenario& s, const WorldDescription& d, 
       plan.waits = a.waits;
     }
     r.actors.push_back(std::move(plan));
+  }
+  for (StreetActor& a : street_actors(s.street, d, s.duration_s, s.seed, s.traffic.size())) {
+    const bool on_foot = a.plan.type == ActorType::pedestrian || a.plan.type == ActorType::cyclist;
+    if (a.plan.speed > 0)
+      check_on_network({a.plan.path, {}}, on_foot ? walkable : world.carriageway, a.where,
+                       ("the path of " + a.plan.name).c_str());
+    r.actors.push_back(std::move(a.plan));
   }
   return r;
 }

@@ -16,6 +16,7 @@
 #include "sim/path.hpp"
 #include "sim/realism.hpp"
 #include "sim/sensor_calibration.hpp"
+#include "sim/street_use.hpp"
 #include "sim/traffic.hpp"
 #include "sim/vehicle_body.hpp"
 #include "sim/vehicle_model.hpp"
@@ -186,6 +187,7 @@ struct Scenario {
   MountErrorConfig mount_error;  // the true LiDAR mount and GPS antenna against the nominal `lidar` / `gps` ones
   ClockConfig clocks;            // the LiDAR's and the CAN's stamping clocks against the reference
   std::vector<TrafficSpec> traffic;
+  StreetUse street;                  // the actors the street's use brings (`street`), after `traffic`'s
   std::vector<KidnapFault> kidnaps;  // `faults:` entries of kind kidnap
   // `localizer`: the method here; the rest of the section (parameter overrides) belongs to the
   // localizer and is read by the tools from `text`, since sim/ does not know the localizer.

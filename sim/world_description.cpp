@@ -32,6 +32,8 @@ MarkingStyle read_marking(const YamlReader& y, const YAML::Node& n) {
   y.fail(n, "marking must be solid, dashed or none, got '" + s + "'");
 }
 
+}  // namespace
+
 RoadSide read_side(const YamlReader& y, const YAML::Node& n) {
   const std::string s = y.string(n, "side");
   if (s == "left") return RoadSide::left;
@@ -39,6 +41,8 @@ RoadSide read_side(const YamlReader& y, const YAML::Node& n) {
   if (s == "both") return RoadSide::both;
   y.fail(n, "side must be left, right or both, got '" + s + "'");
 }
+
+namespace {
 
 CurbProfile read_curb_profile(const YamlReader& y, const YAML::Node& n) {
   const std::string s = y.string(n, "curb_profile");

@@ -210,6 +210,9 @@ struct WorldDescription {
 };
 
 WorldDescription load_world_description(const std::string& path);
+
+// A `side` key: left, right or both (of a road, in its centreline's direction).
+RoadSide read_side(const YamlReader& y, const YAML::Node& n);
 // A world that is a Lanelet2 map and nothing else (`lidarloop world MAP.osm`), named after the file.
 WorldDescription lanelet2_world_description(const std::string& osm_path);
 // A world that is an OpenDRIVE map and nothing else (`lidarloop world MAP.xodr`), named after the file.
