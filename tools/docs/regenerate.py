@@ -38,7 +38,8 @@ END = "<!-- end generated -->"
 # The scenario suite as CTest runs it (tests/CMakeLists.txt): every scenario at its own seed, and
 # dynamic_campus also at seed 8.
 SUITE = ["static_campus", "dynamic_campus", "bus_occlusion", "straight_road", "intersections", "gps_degraded",
-         "closed_loop_campus", "changed_world", "kidnap", "gps_jump_parked", "cold_start_parked"]
+         "closed_loop_campus", "changed_world", "kidnap", "gps_jump_parked", "cold_start_parked",
+         "busy_street"]
 PAPER_SCENARIOS = [("static", "static_campus", "Table II"), ("dynamic", "dynamic_campus", "Table III")]
 GICP_SCENARIOS = ["static_campus", "dynamic_campus", "bus_occlusion"]
 # Integrity over many seeds: the scenarios, the seeds (LIDARLOOP_INTEGRITY_SEEDS, a compare --seeds list)
