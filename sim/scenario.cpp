@@ -557,12 +557,37 @@ ResolvedScenario resolve_scenario(const Scenario& s, const WorldDescription& d, 
     }
     r.actors.push_back(std::move(plan));
   }
+  std::vector<std::string> where;
+  for (const TrafficSpec& a : s.traffic) where.push_back(a.path.where);
+  std::vector<ActorPlan> parked_by_street;
   for (StreetActor& a : street_actors(s.street, d, s.duration_s, s.seed, s.traffic.size())) {
     const bool on_foot = a.plan.type == ActorType::pedestrian || a.plan.type == ActorType::cyclist;
     if (a.plan.speed > 0)
       check_on_network({a.plan.path, {}}, on_foot ? walkable : world.carriageway, a.where,
                        ("the path of " + a.plan.name).c_str());
+    else
+      parked_by_street.push_back(a.plan);
+    where.push_back(a.where);
     r.actors.push_back(std::move(a.plan));
+  }
+  // A parked row leaves what room it leaves: the car and every moving vehicle must fit past it, over
+  // the stretch each covers in the drive (the ego's at its highest set speed).
+  if (!parked_by_street.empty()) {
+    const double ego_reach = std::max(s.ego.speed, s.ego.initial_speed) * s.duration_s;
+    const double ego_to =
+        r.ego_route.closed ? s.ego.start_at + ego_reach : std::min(s.ego.start_at + ego_reach, r.ego_route.length);
+    const std::string ego_conflict =
+        drives_through_parked(r.ego_route, s.ego.start_at, ego_to, actor_footprint(ActorType::car), parked_by_street);
+    if (!ego_conflict.empty())
+      throw InputError(s.ego.route.where + ": the ego's route " + ego_conflict +
+                       " (`street.parking`); give the route an offset that clears the row");
+    for (size_t i = 0; i < r.actors.size(); ++i) {
+      const ActorPlan& a = r.actors[i];
+      if (a.speed <= 0 || a.type == ActorType::pedestrian || a.type == ActorType::cyclist) continue;
+      const std::string conflict = drives_through_parked(
+          a.path, actor_distance(a, 0), actor_distance(a, s.duration_ns()), actor_footprint(a.type), parked_by_street);
+      if (!conflict.empty()) throw InputError(where[i] + ": " + a.name + " " + conflict + " (`street.parking`)");
+    }
   }
   return r;
 }

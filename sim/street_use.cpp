@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <numbers>
+#include <sstream>
 
 #include "common/input_error.hpp"
 #include "sim/counter_rng.hpp"
@@ -18,6 +20,11 @@ constexpr double kMinSpeedMps = 0.3;
 // Spacing of the points along a road at which its carriageway is tested against another road's curb:
 // far below any road's width, so no junction's mouth is missed.
 constexpr double kJunctionProbeStepM = 1.0;
+// Spacing of a bus line's points: fine enough that its pull-in is a smooth curve.
+constexpr double kBusLineStepM = 1.0;
+// Spacing of the poses at which a moving vehicle is tested against the parked ones, and how much of
+// each footprint's edge may touch without counting (the meshes' rounding and mirrors).
+constexpr double kDriveThroughStepM = 0.5, kDriveThroughToleranceM = 0.05;
 
 // Draws in a fixed order from one counter-based stream, so the actors depend on the seed alone.
 struct Draws {
@@ -80,6 +87,7 @@ std::string actor_name(ActorType type, size_t index) { return actor_type_name(ty
 
 struct Builder {
   const WorldDescription& world;
+  const std::vector<BusStopSpec>& bus_stops;
   Draws draws;
   size_t next_index;
   std::vector<StreetActor> out;
@@ -97,6 +105,11 @@ struct Builder {
     for (const CrosswalkSpec& x : world.crosswalks)
       if (x.road == r.road->name)
         out.push_back({x.at - x.width / 2 - c.crosswalk_clearance_m, x.at + x.width / 2 + c.crosswalk_clearance_m});
+    for (const BusStopSpec& b : bus_stops)
+      if (b.road == r.road->name && b.side == side) {
+        const double zone = actor_footprint(ActorType::bus).length / 2 + b.pull_in_m;
+        out.push_back({b.at - zone, b.at + zone});
+      }
     const Path centre = make_path(r.road->centreline, r.road->closed);
     for (const RoadSpec& other : world.roads) {
       if (&other == r.road) continue;
@@ -211,14 +224,38 @@ struct Builder {
     }
   }
 
+  // The bus's line: the centre of its side's curb lane, moving to the curb over pull_in_m before the
+  // stop and back after it, sampled along the whole road, in its direction of travel.
+  Path bus_line(const BusStopSpec& b, const RoadRef& r) const {
+    const RoadSpec& road = *r.road;
+    const double lane_width = road.width / road.lanes;
+    const double lane = road.lanes == 1 && !road.one_way ? 0.0 : road.width / 2 - lane_width / 2;
+    const double curb = road.width / 2 - b.curb_gap_m - actor_footprint(ActorType::bus).width / 2;
+    const double hold = actor_footprint(ActorType::bus).length / 2;
+    Polyline2d line;
+    for (double s = 0; s < r.length; s += kBusLineStepM) {
+      double d = std::abs(s - b.at);
+      if (road.closed) d = std::min(d, r.length - d);
+      const double w = std::clamp(1 - (d - hold) / b.pull_in_m, 0.0, 1.0);
+      line.push_back(beside_centreline(road, s, sign_of(b.side) * (lane + (curb - lane) * w)));
+    }
+    if (road.closed) {
+      line.push_back(line.front());
+    } else {
+      line.push_back(beside_centreline(road, r.length, sign_of(b.side) * lane));
+    }
+    if (against_centreline(road, b.side)) std::reverse(line.begin(), line.end());
+    return make_path(std::move(line), road.closed);
+  }
+
   void bus_stop(const BusStopSpec& b) {
     const RoadRef r = road_of(world, b.road, b.where);
     if (!(b.at >= 0 && b.at <= r.length))
       throw InputError(b.where + ": the stop must lie along road '" + b.road + "' (0 to " +
                        std::to_string(int(r.length)) + " m)");
-    const double half_width = actor_footprint(ActorType::bus).width / 2;
-    const double lateral = sign_of(b.side) * (r.road->width / 2 - b.curb_gap_m - half_width);
-    auto [path, stop] = parallel_path(*r.road, lateral, against_centreline(*r.road, b.side), b.at);
+    const double curb = r.road->width / 2 - b.curb_gap_m - actor_footprint(ActorType::bus).width / 2;
+    Path path = bus_line(b, r);
+    double stop = path.project(beside_centreline(*r.road, b.at, sign_of(b.side) * curb));
     ActorPlan plan;
     plan.type = ActorType::bus;
     plan.speed = b.speed_mps;
@@ -254,7 +291,44 @@ std::vector<StreetStretch> read_stretches(const YamlReader& y, YamlMap& section)
   return out;
 }
 
+// Whether two footprints (centre, heading, size) overlap, by the separating axis theorem.
+bool footprints_overlap(const Pose2d& a, const ActorFootprint& fa, const Pose2d& b, const ActorFootprint& fb) {
+  const Eigen::Vector2d ca(a.x, a.y), cb(b.x, b.y);
+  const Eigen::Vector2d axes[4] = {{std::cos(a.yaw), std::sin(a.yaw)},
+                                   {-std::sin(a.yaw), std::cos(a.yaw)},
+                                   {std::cos(b.yaw), std::sin(b.yaw)},
+                                   {-std::sin(b.yaw), std::cos(b.yaw)}};
+  const auto reach = [&](const ActorFootprint& f, const Eigen::Vector2d& u, const Eigen::Vector2d& v,
+                         const Eigen::Vector2d& axis) {
+    return (f.length / 2 - kDriveThroughToleranceM) * std::abs(u.dot(axis)) +
+           (f.width / 2 - kDriveThroughToleranceM) * std::abs(v.dot(axis));
+  };
+  for (const Eigen::Vector2d& axis : axes)
+    if (std::abs((cb - ca).dot(axis)) > reach(fa, axes[0], axes[1], axis) + reach(fb, axes[2], axes[3], axis))
+      return false;
+  return true;
+}
+
 }  // namespace
+
+std::string drives_through_parked(const Path& path, double from_s, double to_s, const ActorFootprint& footprint,
+                                  const std::vector<ActorPlan>& parked) {
+  for (double s = from_s; s <= to_s; s += kDriveThroughStepM) {
+    const Pose2d p = path.pose_at(s);
+    for (const ActorPlan& a : parked) {
+      const Pose2d q = a.path.pose_at(0);
+      const ActorFootprint f = actor_footprint(a.type);
+      if (std::hypot(p.x - q.x, p.y - q.y) > (footprint.length + f.length) / 2) continue;
+      if (footprints_overlap(p, footprint, q, f)) {
+        std::ostringstream msg;
+        msg << std::fixed << std::setprecision(1) << "drives through the parked " << a.name << " at (" << q.x << ", "
+            << q.y << "), " << s << " m along its path";
+        return msg.str();
+      }
+    }
+  }
+  return "";
+}
 
 void read_street_use(const YamlReader& y, const YAML::Node& node, StreetUse& street) {
   YamlMap root(y, node, "street");
@@ -317,6 +391,7 @@ void read_street_use(const YamlReader& y, const YAML::Node& node, StreetUse& str
       b.at = y.number_in(m.required("at"), "at", 0.0, 1e6);
       b.arrive_s = y.number_in(m.required("arrive_s"), "arrive_s", 0.0, 1e5);
       m.number("dwell_s", b.dwell_s, 0.0, 3600.0)
+          .number("pull_in_m", b.pull_in_m, 1.0, 100.0)
           .number("speed_mps", b.speed_mps, 1.0, 30.0)
           .number("curb_gap_m", b.curb_gap_m, 0.0, 1.0)
           .done();
@@ -333,7 +408,7 @@ bool StreetUse::empty() const {
 
 std::vector<StreetActor> street_actors(const StreetUse& street, const WorldDescription& world, double duration_s,
                                        uint64_t seed, size_t first_index) {
-  Builder b{world, {CounterRng(seed, kStreetStream)}, first_index, {}};
+  Builder b{world, street.bus_stops, {CounterRng(seed, kStreetStream)}, first_index, {}};
   b.parking(street.parking);
   const SidewalkPedestrianConfig& walk = street.sidewalk_pedestrians;
   b.along(walk.stretches, walk.per_100m / 100, ActorType::pedestrian, walk.speed_mps, walk.speed_sigma_mps,

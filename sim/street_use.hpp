@@ -82,7 +82,8 @@ struct CyclistConfig {
   double from_curb_m = 0.8;
 };
 
-// A bus that drives up its lane, stands at the stop with its door side at the curb, and drives on.
+// A bus that drives up its lane, pulls in to stand at the stop with its door side at the curb, and
+// pulls out to drive on. No one parks in the bus zone: the bus's length and its pull-in and pull-out.
 struct BusStopSpec {
   std::string where, road;
   RoadSide side = RoadSide::right;  // the stop's side of the road; the bus travels with that side's traffic
@@ -93,6 +94,10 @@ struct BusStopSpec {
   double dwell_s = 30;
   double speed_mps = 8.3;   // 30 km/h, the campus streets' design speed, m/s
   double curb_gap_m = 0.3;  // as a parked vehicle's
+  // Along the road over which the bus moves between its lane and the curb, before and after the stop:
+  // with the bus's 12 m, a 42 m (138 ft) zone, within the 90-150 ft curbside stops of TCRP Report 19
+  // (Guidelines for the Location and Design of Bus Stops).
+  double pull_in_m = 15;
 };
 
 struct StreetUse {
@@ -113,6 +118,12 @@ struct StreetActor {
   ActorPlan plan;
   std::string where;
 };
+
+// The first place where a vehicle following `path` from arc length `from_s` to `to_s` (with the given
+// footprint, centred on the path; unwrapped on closed paths) would drive through one of the `parked`
+// actors: a description naming the place and the actor, or empty.
+std::string drives_through_parked(const Path& path, double from_s, double to_s, const ActorFootprint& footprint,
+                                  const std::vector<ActorPlan>& parked);
 
 // Every actor the section asks for over a drive of `duration_s`, drawn from `seed` (the scenario's):
 // the same seed gives the same actors. Names are "<type>_<first_index + k>", continuing the scenario's

@@ -177,8 +177,47 @@ TEST(StreetUse, ABusStandsAtItsStopForItsDwellTimeAtTheCurb) {
     EXPECT_NEAR(at(t).x, 1500, 1e-6) << t;
     EXPECT_NEAR(at(t).y, kWidth / 2 - street.bus_stops[0].curb_gap_m - actor_footprint(ActorType::bus).width / 2, 1e-6);
   }
-  EXPECT_GT(at(10).x, 1500 + 50);  // coming west along the left side
-  EXPECT_LT(at(60).x, 1500 - 50);  // and gone on after its dwell
+  // Coming west along the left side in the centre of its lane, and gone on after its dwell.
+  EXPECT_GT(at(10).x, 1500 + 50);
+  EXPECT_NEAR(at(10).y, kWidth / 4, 1e-6);
+  EXPECT_LT(at(60).x, 1500 - 50);
+  EXPECT_NEAR(at(60).y, kWidth / 4, 1e-6);
+}
+
+TEST(StreetUse, NobodyParksInABusZone) {
+  StreetUse street = read(R"(
+parking: {occupancy: 1, truck_share: 0, stretches: [{road: main, side: left, to: 1900}]}
+bus_stops: [{road: main, side: left, at: 1000, arrive_s: 20}]
+)");
+  const double zone = actor_footprint(ActorType::bus).length / 2 + street.bus_stops[0].pull_in_m;
+  size_t parked = 0;
+  for (const auto& a : street_actors(street, world(), 60, 1, 0)) {
+    if (a.plan.speed > 0) continue;
+    ++parked;
+    const double x = a.plan.path.pose_at(0).x, half = actor_footprint(a.plan.type).length / 2;
+    EXPECT_TRUE(x + half <= 1000 - zone || x - half >= 1000 + zone) << x;
+  }
+  EXPECT_GT(parked, 250u);
+}
+
+TEST(StreetUse, AVehicleDrivingThroughAParkedOneIsFound) {
+  const Path along_x = make_path({{0, 0}, {100, 0}}, false);
+  const auto parked_at = [](double y) {
+    ActorPlan p;
+    p.name = "car_3";
+    p.path = make_path({{50, y}, {50.001, y}}, false);
+    return std::vector<ActorPlan>{p};
+  };
+  const ActorFootprint car = actor_footprint(ActorType::car);
+  // Two cars side by side overlap while their centres are less than a car's width apart.
+  EXPECT_NE(drives_through_parked(along_x, 0, 100, car, parked_at(car.width - 0.25)).find("car_3 at (50.0, 1.6)"),
+            std::string::npos);
+  EXPECT_EQ(drives_through_parked(along_x, 0, 100, car, parked_at(car.width + 0.05)), "");
+  EXPECT_EQ(
+      drives_through_parked(along_x, 0, 100, actor_footprint(ActorType::bus), parked_at(car.width + 0.05)).substr(0, 6),
+      "drives");
+  // Only the stretch driven counts: stopping short of the parked car is no conflict.
+  EXPECT_EQ(drives_through_parked(along_x, 0, 40, car, parked_at(0)), "");
 }
 
 TEST(StreetUse, TheSameSeedGivesTheSameStreetAndAnotherSeedAnother) {
