@@ -1,6 +1,7 @@
 #include "mapping/curb_label.hpp"
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "common/points_kd_tree.hpp"
@@ -23,7 +24,8 @@ Eigen::Vector2d left_normal(const Polyline2d& line, size_t i) {
   const size_t next = i + 1 < n ? i + 1 : (closed ? 1 : n - 1);
   const Eigen::Vector2d along = line[next] - line[prev];
   const double length = along.norm();
-  return length > 0 ? Eigen::Vector2d(-along.y(), along.x()) / length : Eigen::Vector2d::Zero();
+  if (!(length > 0)) return Eigen::Vector2d::Zero();
+  return Eigen::Vector2d(-along.y(), along.x()) / length;
 }
 
 }  // namespace
@@ -69,7 +71,8 @@ CurbMap label_curb_map(const CurbMap& map, const std::vector<std::vector<CurbSta
   std::vector<Eigen::Vector2d> points;
   for (const auto& ring : rings)
     for (const CurbStation& s : ring) stations.push_back(&s), points.push_back(s.point);
-  const PointsKdTree index(&points);
+  std::optional<PointsKdTree> index;  // none without cross-sections
+  if (!points.empty()) index.emplace(&points);
   std::normal_distribution<double> normal(0.0, 1.0);
   CurbMap out = map;
   for (size_t k = 0; k < map.curbs.size(); ++k) {
@@ -90,7 +93,7 @@ CurbMap label_curb_map(const CurbMap& map, const std::vector<std::vector<CurbSta
       double offset = 0;
       uint32_t nearest = 0;
       double d2 = 0;
-      if (!points.empty() && index.tree.knnSearch(line[i].data(), 1, &nearest, &d2) == 1 &&
+      if (index && index->tree.knnSearch(line[i].data(), 1, &nearest, &d2) == 1 &&
           d2 <= kMaxStationDistance * kMaxStationDistance) {
         const CurbStation& s = *stations[nearest];
         if (normal_out.dot(s.normal) < 0) normal_out = -normal_out;  // away from the carriageway

@@ -24,7 +24,7 @@ FieldFigures measure(const SlamMapErrorConfig& c, double over, int seeds, double
   double sum2 = 0, rel2 = 0, rot2 = 0, east = 0, north = 0;
   size_t n = 0, n_rel = 0;
   for (int seed = 1; seed <= seeds; ++seed) {
-    std::mt19937_64 rng(uint64_t(seed));
+    std::mt19937_64 rng{uint64_t(seed)};
     const SlamErrorField field(c, rng);
     const double angle = seed * 0.7;  // a track in another direction for each draw
     const Eigen::Vector2d u(std::cos(angle), std::sin(angle)), start(seed * 1000.0, -seed * 500.0);
