@@ -13,6 +13,7 @@
 #include "common/yaml_reader.hpp"
 #include "localizer/intensity_map.hpp"
 #include "localizer/point_map.hpp"
+#include "mapping/curb_label.hpp"
 #include "mapping/survey_map.hpp"
 #include "sim/materials.hpp"
 #include "sim/realism.hpp"
@@ -32,6 +33,8 @@ struct MappingOptions {
   double max_range = 40.0;  // m: farther ground returns are too sparse to help
   uint64_t seed = 1;        // the LiDAR's noise and the survey error
   SurveyErrorConfig survey_error;
+  // How the curb layer is drawn from the survey (mapping/curb_label.hpp): the world's line by default.
+  CurbLabelConfig curb_label;
   // The survey car's HDL-32E (Hdl32eConfig::unit_serial): another unit than the test car's, whose
   // default serial is 1, so the map's per-laser intensity gains are not the scans'.
   uint64_t survey_unit_serial = 2;
@@ -53,22 +56,28 @@ struct MappingOptions {
 
 // The mapping options of a realism profile (sim/realism.hpp): the `typical` map is the defaults above (an
 // RTK-INS survey by another HDL-32E unit); `ideal` is the world itself (no pose error, the test car's own
-// unit, ideal ground); `harsh` is a survey that had no RTK fix (see mapping_drive.cpp for the figures).
+// unit, ideal ground); `harsh` is a map made without RTK, a GNSS-anchored SLAM map with labelling noise
+// (see mapping_drive.cpp for the figures).
 MappingOptions mapping_options_for(Realism realism);
 
 // The world a map with these options is built from: the world file, on ideal ground if options say so.
 LoadedWorld load_mapped_world(const std::string& world, const MappingOptions& options);
 
-// Overrides of the survey settings from a YAML mapping: unit_serial, sigma_xy_m, correlation_length_m,
-// heading_sigma_deg, heading_correlation_length_m, sample_spacing_m.
+// Overrides of the survey settings from a YAML mapping: unit_serial, provenance (rtk_ins or slam; the
+// other keys then override that provenance's figures), sigma_xy_m, correlation_length_m,
+// heading_sigma_deg, heading_correlation_length_m (rtk_ins), slam_absolute_m, slam_relative_m,
+// slam_relative_over_m (slam), sample_spacing_m, curb_label (face_foot, face_top or gutter_line),
+// label_noise_m, label_noise_correlation_m.
 void read_survey_options(const YamlReader& yaml, const YAML::Node& node, MappingOptions& options);
 
 // The survey the mapping drive with these options makes: its lanes and its error, drawn from an engine
 // seeded with options.seed (the same every time for the same options).
 SurveyDrive mapping_survey(const WorldDescription& description, const MappingOptions& options);
 
-// The surveyed curb layer: the world's curbs densified to the survey's sample spacing and moved by the
-// survey error (survey_curb_map).
+// The surveyed curb layer: the world's curbs densified to the survey's sample spacing, drawn to the
+// labelling convention with its noise (label_curb_map, from an engine of its own seeded with
+// options.seed, so the survey's draws do not change with the labelling), and moved by the survey error
+// (survey_curb_map).
 CurbMap surveyed_curbs(const World& world, const SurveyDrive& survey, const MappingOptions& options);
 
 // `world_hash` identifies what the map is built from (see map_cache.hpp); it goes into the header.

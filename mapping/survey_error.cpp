@@ -7,14 +7,13 @@
 
 namespace lidarloop {
 
-namespace {
-
-// The shortest text that reads back as the same double, so any change of a setting changes the text.
-std::string exact(double v) {
+std::string exact_number(double v) {
   char buffer[32];
   const auto end = std::to_chars(buffer, buffer + sizeof buffer, v).ptr;
   return std::string(buffer, end);
 }
+
+namespace {
 
 // One exact-discretisation step of a first-order Gauss-Markov process (see the header).
 double gauss_markov_step(double e, double ds, double sigma, double length, double n) {
@@ -24,11 +23,25 @@ double gauss_markov_step(double e, double ds, double sigma, double length, doubl
 
 }  // namespace
 
+const char* map_provenance_name(MapProvenance provenance) {
+  switch (provenance) {
+    case MapProvenance::rtk_ins:
+      return "rtk_ins";
+    case MapProvenance::slam:
+      return "slam";
+  }
+  return "?";
+}
+
 std::string SurveyErrorConfig::describe() const {
-  return "sigma_xy_m=" + exact(sigma_xy_m) + " correlation_length_m=" + exact(correlation_length_m) +
-         " heading_sigma_deg=" + exact(heading_sigma_rad * kDegPerRad) +
-         " heading_correlation_length_m=" + exact(heading_correlation_length_m) +
-         " sample_spacing_m=" + exact(sample_spacing_m);
+  const std::string provenance_text =
+      provenance == MapProvenance::rtk_ins
+          ? ""
+          : std::string(" provenance=") + map_provenance_name(provenance) + " " + slam.describe();
+  return "sigma_xy_m=" + exact_number(sigma_xy_m) + " correlation_length_m=" + exact_number(correlation_length_m) +
+         " heading_sigma_deg=" + exact_number(heading_sigma_rad * kDegPerRad) +
+         " heading_correlation_length_m=" + exact_number(heading_correlation_length_m) +
+         " sample_spacing_m=" + exact_number(sample_spacing_m) + provenance_text;
 }
 
 SurveyErrorTrack simulate_survey_error(const SurveyErrorConfig& c, double length_m, std::mt19937_64& rng) {

@@ -15,10 +15,20 @@
 
 #include "common/pose2d.hpp"
 #include "common/units.hpp"
+#include "mapping/slam_map_error.hpp"
 
 namespace lidarloop {
 
+// How the map was made, which sets its error. rtk_ins: a mobile-mapping survey whose every scan is
+// placed with an RTK-aided INS (the Gauss-Markov error below, over the distance driven). slam: a
+// GNSS-anchored LiDAR-SLAM map (mapping/slam_map_error.hpp: an error field over the ground, the same
+// on every pass of a street).
+enum class MapProvenance { rtk_ins, slam };
+const char* map_provenance_name(MapProvenance provenance);
+
 struct SurveyErrorConfig {
+  MapProvenance provenance = MapProvenance::rtk_ins;
+
   // Applanix POS LV 220 datasheet, RTK column: X, Y position 0.020 m RMS (each horizontal axis).
   double sigma_xy_m = 0.02;
   // Assumption, not on any datasheet: the distance over which the position error decorrelates (RTK
@@ -35,8 +45,16 @@ struct SurveyErrorConfig {
   // must stay far below the correlation lengths (0.5 m against 100 m loses 0.1 % of the variance).
   double sample_spacing_m = 0.5;
 
-  std::string describe() const;  // every field as text, for the map cache key and the map header
+  // The map's error when provenance is slam (the fields above, but sample_spacing_m, are then unused).
+  SlamMapErrorConfig slam;
+
+  // Every field as text, for the map cache key and the map header. An rtk_ins survey's text has no
+  // provenance in it, so maps made before there was a choice keep their cache key.
+  std::string describe() const;
 };
+
+// The shortest text that reads back as the same double, so any change of a setting changes the text.
+std::string exact_number(double v);
 
 // The survey error along a drive of `length_m`, sampled every config.sample_spacing_m.
 struct SurveyErrorTrack {

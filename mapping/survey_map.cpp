@@ -1,5 +1,6 @@
 #include "mapping/survey_map.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -27,6 +28,31 @@ const Polyline2d& points_of(const Curb& curb) {
     return curb.points;
   else
     return curb;
+}
+
+// A SLAM map's error sampled along the drive, every config.sample_spacing_m of distance driven, at the
+// place the survey car is then (the error belongs to the place, mapping/slam_map_error.hpp). Between
+// the last sample of one lane and the first of the next the track interpolates between two places, over
+// less than one spacing of distance.
+SurveyErrorTrack slam_error_along(const SurveyDrive& drive, const SurveyErrorConfig& c, std::mt19937_64& rng) {
+  if (!(c.sample_spacing_m > 0)) throw std::invalid_argument("survey error: the sample spacing must be positive");
+  const SlamErrorField field(c.slam, rng);
+  SurveyErrorTrack track;
+  track.spacing_m = c.sample_spacing_m;
+  const size_t n = size_t(std::ceil(drive.length_m / c.sample_spacing_m)) + 1;
+  track.samples.reserve(n);
+  size_t lane = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const double s = std::min(double(k) * c.sample_spacing_m, drive.length_m);
+    while (lane + 1 < drive.lanes.size() && s > drive.lanes[lane].start_m + drive.lanes[lane].path.length) ++lane;
+    if (drive.lanes.empty()) {
+      track.samples.push_back({});
+      continue;
+    }
+    const Pose2d at = drive.lanes[lane].path.pose_at(s - drive.lanes[lane].start_m);
+    track.samples.push_back(field.at({at.x, at.y}));
+  }
+  return track;
 }
 
 }  // namespace
@@ -65,7 +91,8 @@ SurveyDrive plan_survey(const WorldDescription& d, const SurveyErrorConfig& conf
       if (per_direction >= 2) add(road, Lane::left, backward);
     }
   }
-  drive.error = simulate_survey_error(config, drive.length_m, rng);
+  drive.error = config.provenance == MapProvenance::slam ? slam_error_along(drive, config, rng)
+                                                         : simulate_survey_error(config, drive.length_m, rng);
   return drive;
 }
 

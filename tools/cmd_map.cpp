@@ -55,7 +55,8 @@ void print_survey(const std::string& world, const MappingOptions& o, const std::
   }
   const double n = double(std::max<size_t>(1, survey.error.samples.size()));
   const CurbMap world_curbs = densify_curb_map(w.world.curb_map(), o.survey_error.sample_spacing_m);
-  const CurbShiftStats c = curb_shift_stats(world_curbs, survey_curb_map(world_curbs, survey));
+  // The map's curbs as the map holds them: drawn to its labelling convention, then moved by the survey.
+  const CurbShiftStats c = curb_shift_stats(world_curbs, surveyed_curbs(w.world, survey, o));
   auto fixed = [](double v, int digits) {
     std::ostringstream s;
     s << std::fixed << std::setprecision(digits) << v;

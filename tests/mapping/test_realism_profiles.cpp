@@ -1,5 +1,5 @@
 // Realism profiles as the map sees them: typical is the default survey, ideal a survey that is the world,
-// harsh a worse survey; each its own map in the cache.
+// harsh a map made without RTK (GNSS-anchored SLAM, labelled curbs); each its own map in the cache.
 #include <gtest/gtest.h>
 
 #include "mapping/mapping_drive.hpp"
@@ -16,8 +16,13 @@ TEST(RealismProfiles, EachProfileSurveysItsOwnMap) {
   EXPECT_EQ(ideal.survey_error.heading_sigma_rad, 0.0);
   EXPECT_EQ(ideal.survey_unit_serial, Hdl32eConfig{}.unit_serial);  // the car's own unit
   EXPECT_TRUE(ideal.ideal_ground);
-  EXPECT_GT(harsh.survey_error.sigma_xy_m, typical.survey_error.sigma_xy_m);
-  EXPECT_GT(harsh.survey_error.heading_sigma_rad, typical.survey_error.heading_sigma_rad);
+  // harsh: a GNSS-anchored SLAM map, its curbs labelled at the face's top with noise.
+  EXPECT_EQ(typical.survey_error.provenance, MapProvenance::rtk_ins);
+  EXPECT_EQ(harsh.survey_error.provenance, MapProvenance::slam);
+  EXPECT_GT(harsh.survey_error.slam.absolute_sigma_m, typical.survey_error.sigma_xy_m);
+  EXPECT_EQ(harsh.curb_label.convention, CurbLabel::face_top);
+  EXPECT_GT(harsh.curb_label.noise_m, 0.0);
+  EXPECT_TRUE(typical.curb_label.is_default());
   EXPECT_NE(ideal.describe(), typical.describe());
   EXPECT_NE(harsh.describe(), typical.describe());
 }
