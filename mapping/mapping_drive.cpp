@@ -62,6 +62,8 @@ std::string MappingOptions::describe() const {
     << " survey_unit_serial=" << survey_unit_serial << " " << survey_error.describe()
     << " point_voxel=" << point_voxel_m << " point_scan_stride=" << point_scan_stride;
   if (ideal_ground) s << " ideal_ground=1";  // absent when off, so typical maps keep their cache key
+  // Uniform paint adds nothing, so the maps made before worn paint keep their keys.
+  if (const std::string p = paint.describe_survey(); !p.empty()) s << " " << p;
   return s.str();
 }
 
@@ -73,6 +75,7 @@ MappingOptions mapping_options_for(Realism realism) {
       o.survey_error.heading_sigma_rad = 0;
       o.survey_unit_serial = Hdl32eConfig{}.unit_serial;  // the test car's own unit
       o.ideal_ground = true;
+      o.paint = paint_config_for(realism);
       break;
     case Realism::typical:
       break;  // the defaults: an RTK-INS survey (SurveyErrorConfig)
@@ -82,6 +85,7 @@ MappingOptions mapping_options_for(Realism realism) {
       // Applanix datasheet's DGPS column is worse still (decimetres), so this is a mild "harsh".
       o.survey_error.sigma_xy_m = 0.10;
       o.survey_error.heading_sigma_rad = 0.10 * kDeg;
+      o.paint = paint_config_for(realism);
       break;
   }
   return o;
@@ -90,6 +94,7 @@ MappingOptions mapping_options_for(Realism realism) {
 LoadedWorld load_mapped_world(const std::string& world, const MappingOptions& options) {
   WorldDescription description = load_world_description_of(world);
   if (options.ideal_ground) description = on_ideal_ground(std::move(description));
+  description.paint = PaintConditions{options.paint, PaintDay::survey};
   return build_loaded_world(std::move(description));
 }
 
