@@ -67,7 +67,7 @@ void read_paint_config(const YamlReader& y, const YAML::Node& n, PaintConfig& c)
       .number("fade_factor", c.fade_factor, 0.0, 1.0)
       .number("repainted_fraction", c.repainted_fraction, 0.0, 1.0)
       .number("repaint_mcd", c.repaint_mcd, 0.0, kMaxRetro)
-      .integer("seed", c.seed, 0, UINT64_MAX)
+      .integer("seed", c.seed, 0, uint64_t(1) << 62)
       .done();
   if (c.faded_fraction + c.repainted_fraction > 1.0) y.fail(n, "paint: faded_fraction + repainted_fraction exceeds 1");
 }

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <map>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -53,6 +54,9 @@ double r_squared(const std::vector<double>& x, const std::vector<double>& y) {
 TEST(PaintWear, TheDrawnRetroreflectivityHasTheConfiguredMeanSigmaAndFloor) {
   const PaintConfig typical;
   const std::vector<double> r = retro_of(draw(typical, PaintDay::survey));
+  // The measured figures, for a report (--gtest_output=xml).
+  RecordProperty("retro_mean", std::to_string(mean_of(r)));
+  RecordProperty("retro_sigma", std::to_string(sigma_of(r)));
   // The floor clamps the 2.3 % of draws 2 sigma below the mean: the mean moves up by about 0.4 mcd and
   // the sigma shrinks by about 3 %.
   EXPECT_NEAR(mean_of(r), typical.retro_mean_mcd, 2.0);
@@ -80,6 +84,7 @@ TEST(PaintWear, LidarReflectivityFollowsRetroreflectivityWithTheConfiguredRSquar
     std::vector<double> x, y;
     for (const auto& l : looks) x.push_back(l.retro_mcd), y.push_back(l.reflectivity);
     EXPECT_NEAR(r_squared(x, y), wanted, 0.02) << "configured R^2 " << wanted;
+    RecordProperty("r2_for_" + std::to_string(wanted), std::to_string(r_squared(x, y)));
     // On average a marking as bright as material_retro_mcd is its material.
     EXPECT_NEAR(mean_of(y), kDim * c.retro_mean_mcd / c.material_retro_mcd, 0.003);
   }
@@ -88,6 +93,7 @@ TEST(PaintWear, LidarReflectivityFollowsRetroreflectivityWithTheConfiguredRSquar
   std::vector<double> x, y;
   for (const auto& l : looks) x.push_back(l.retro_mcd), y.push_back(l.reflectivity);
   EXPECT_NEAR(r_squared(x, y), PaintConfig{}.intensity_r2, 0.03);
+  RecordProperty("r2_typical", std::to_string(r_squared(x, y)));
 }
 
 TEST(PaintWear, TheWornShareOfPiecesIsTheConfiguredFraction) {
@@ -181,6 +187,7 @@ TEST(PaintWear, AWorldLosesTheWornShareOfItsPaintArea) {
   const PaintConfig c;
   const double worn = paint_area(build(PaintConditions{c, PaintDay::survey}));
   EXPECT_NEAR(1 - worn / uniform, c.worn_fraction, 0.02);
+  RecordProperty("worn_area_fraction", std::to_string(1 - worn / uniform));
 }
 
 TEST(PaintWear, UniformPaintBuildsTheWorldAsBefore) {
@@ -220,7 +227,7 @@ TEST(PaintWear, TheSurveyAndTheDriveAgreeOnEveryMarkingNotChanged) {
     return out;
   };
   // Worn pieces keep their vertices, so the two meshes share every vertex and triangle index.
-  ASSERT_EQ(survey.mesh.vertices, drive.mesh.vertices);
+  ASSERT_TRUE(survey.mesh.vertices == drive.mesh.vertices);
   const auto before = pieces(survey), after = pieces(drive);
   size_t equal = 0, gone = 0;
   for (const auto& [tri, r] : before) {
@@ -232,6 +239,7 @@ TEST(PaintWear, TheSurveyAndTheDriveAgreeOnEveryMarkingNotChanged) {
   }
   EXPECT_EQ(gone, 0u);  // a marking never loses paint between the days: it fades or is re-painted
   const double changed = 1 - double(equal) / double(before.size());
+  RecordProperty("changed_piece_fraction", std::to_string(changed));
   // About the share of markings changed (by area, so roughly): faded and re-painted, 15 %.
   EXPECT_GT(changed, 0.5 * (c.faded_fraction + c.repainted_fraction));
   EXPECT_LT(changed, 2.0 * (c.faded_fraction + c.repainted_fraction));
@@ -250,7 +258,7 @@ TEST(PaintWear, TheProfilesAndTheScenarioKeys) {
   changed.worn_fraction = 0.2;
   EXPECT_NE(changed.describe_survey(), PaintConfig{}.describe_survey());
 
-  const std::string base = "world: campus\nduration_s: 5\n";
+  const std::string base = "world: campus\nduration_s: 5\nego: {route: {road: loop}}\n";
   const Scenario s = parse_scenario(base + "paint: {worn_fraction: 0.25, seed: 9}\n", "paint.yaml");
   EXPECT_EQ(s.paint.worn_fraction, 0.25);
   EXPECT_EQ(s.paint.seed, 9u);
