@@ -31,15 +31,15 @@ PaintConfig paint_config_for(Realism realism) {
   PaintConfig c;
   switch (realism) {
     case Realism::ideal:
+    case Realism::typical:  // uniform paint: see PaintConfig::varied
       c.varied = false;
-      break;
-    case Realism::typical:
       break;
     case Realism::harsh:
       // Markings near the end of their life: R_L about the maintained minimums (FHWA 50-100, middle 75,
       // spread so that 50 is 1 sigma below and 100 one above: assumption), floored at the lower
       // minimum, 50; a third of the area worn, and twice the typical changes since the survey
       // (assumptions).
+      c.varied = true;
       c.retro_mean_mcd = 75;
       c.retro_sigma_mcd = 25;
       c.retro_min_mcd = 50;

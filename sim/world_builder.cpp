@@ -550,8 +550,9 @@ World build_world(const WorldDescription& description, const MaterialTable& mate
   Builder b{description, materials, actors_dir, {}, {}};
   if (description.opendrive) {  // as a Lanelet2 map's below
     OdrBuildReport report;
-    b.world = build_opendrive_world(description.opendrive->map, description.opendrive->params, materials, actors_dir,
-                                    &report);
+    OdrWorldParams params = description.opendrive->params;
+    params.paint = description.paint;
+    b.world = build_opendrive_world(description.opendrive->map, params, materials, actors_dir, &report);
     b.world.name = description.name;
     b.world.import_report = report.summary();
     b.build_buildings();
@@ -561,8 +562,9 @@ World build_world(const WorldDescription& description, const MaterialTable& mate
   if (description.lanelet2) {
     // The road network is the map's; what the world file adds stands on it.
     Lanelet2BuildReport report;
-    b.world =
-        build_lanelet2_world(description.lanelet2->map, description.lanelet2->params, materials, actors_dir, &report);
+    Lanelet2WorldParams params = description.lanelet2->params;
+    params.paint = description.paint;
+    b.world = build_lanelet2_world(description.lanelet2->map, params, materials, actors_dir, &report);
     b.world.name = description.name;
     b.world.import_report = report.summary();
     b.build_buildings();

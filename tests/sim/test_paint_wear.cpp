@@ -12,7 +12,9 @@
 #include <gtest/gtest.h>
 
 #include "common/input_error.hpp"
+#include "sim/lanelet2_world.hpp"
 #include "sim/mesh_shapes.hpp"
+#include "sim/opendrive_world.hpp"
 #include "sim/paint_wear.hpp"
 #include "sim/scenario.hpp"
 #include "test_support.hpp"
@@ -21,6 +23,13 @@ namespace lidarloop {
 namespace {
 
 constexpr int kMarkings = 20000;
+
+// Worn paint with the sourced campus figures (the config's defaults, with varied on).
+PaintConfig worn() {
+  PaintConfig c;
+  c.varied = true;
+  return c;
+}
 constexpr double kLanePaint = 0.65;  // lane_paint's reflectivity (assets/materials.yaml)
 
 std::vector<MarkingLook> draw(const PaintConfig& c, PaintDay day, int n = kMarkings, double material = kLanePaint) {
@@ -88,7 +97,7 @@ TEST(PaintWear, LidarReflectivityFollowsRetroreflectivityWithTheConfiguredRSquar
     // On average a marking as bright as material_retro_mcd is its material.
     EXPECT_NEAR(mean_of(y), kDim * c.retro_mean_mcd / c.material_retro_mcd, 0.003);
   }
-  // The typical profile with its floor and the reflectivity's clamp to 1: still within the studies' range.
+  // The campus figures (varied: true) with their floor and the clamp to 1: still within the studies' range.
   const auto looks = draw(PaintConfig{}, PaintDay::survey);
   std::vector<double> x, y;
   for (const auto& l : looks) x.push_back(l.retro_mcd), y.push_back(l.reflectivity);
@@ -184,21 +193,23 @@ bool same_mesh(const World& a, const World& b) {
 TEST(PaintWear, AWorldLosesTheWornShareOfItsPaintArea) {
   const double uniform = paint_area(build(std::nullopt));
   ASSERT_GT(uniform, 200.0);  // m2: 600 m of lines and a crosswalk
-  const PaintConfig c;
-  const double worn = paint_area(build(PaintConditions{c, PaintDay::survey}));
-  EXPECT_NEAR(1 - worn / uniform, c.worn_fraction, 0.02);
-  RecordProperty("worn_area_fraction", std::to_string(1 - worn / uniform));
+  const PaintConfig c = worn();
+  const double left = paint_area(build(PaintConditions{c, PaintDay::survey}));
+  EXPECT_NEAR(1 - left / uniform, c.worn_fraction, 0.02);
+  RecordProperty("worn_area_fraction", std::to_string(1 - left / uniform));
 }
 
 TEST(PaintWear, UniformPaintBuildsTheWorldAsBefore) {
   const World before = build(std::nullopt);
-  const World ideal = build(PaintConditions{paint_config_for(Realism::ideal), PaintDay::drive});
-  EXPECT_TRUE(same_mesh(before, ideal));
-  EXPECT_TRUE(ideal.paint_materials.empty());
+  for (Realism r : {Realism::ideal, Realism::typical}) {
+    const World uniform = build(PaintConditions{paint_config_for(r), PaintDay::drive});
+    EXPECT_TRUE(same_mesh(before, uniform)) << realism_name(r);
+    EXPECT_TRUE(uniform.paint_materials.empty()) << realism_name(r);
+  }
 }
 
 TEST(PaintWear, TheSameSeedBuildsTheSameWorldByteForByte) {
-  const PaintConditions p{PaintConfig{}, PaintDay::drive};
+  const PaintConditions p{worn(), PaintDay::drive};
   const World a = build(p), b = build(p);
   EXPECT_TRUE(same_mesh(a, b));
   ASSERT_EQ(a.paint_materials.size(), b.paint_materials.size());
@@ -211,7 +222,7 @@ TEST(PaintWear, TheSameSeedBuildsTheSameWorldByteForByte) {
 }
 
 TEST(PaintWear, TheSurveyAndTheDriveAgreeOnEveryMarkingNotChanged) {
-  const PaintConfig c;
+  const PaintConfig c = worn();
   const World survey = build(PaintConditions{c, PaintDay::survey});
   const World drive = build(PaintConditions{c, PaintDay::drive});
   // The same pieces with the same reflectivity where nothing changed; another material where a marking
@@ -246,20 +257,43 @@ TEST(PaintWear, TheSurveyAndTheDriveAgreeOnEveryMarkingNotChanged) {
   EXPECT_GT(after.size(), before.size());  // the re-painted markings' worn pieces are paint again
 }
 
+// Worlds imported from a Lanelet2 or an OpenDRIVE map wear their paint the same way.
+TEST(PaintWear, ImportedWorldsWearTheirPaintToo) {
+  for (const std::string file : {"tests/data/lanelet2/two_lanes.osm", "tests/data/opendrive/small_town.xodr"}) {
+    const bool osm = file.ends_with(".osm");
+    WorldDescription d =
+        osm ? lanelet2_world_description(test::data_path(file)) : opendrive_world_description(test::data_path(file));
+    const World before = build_world(d, test::materials(), test::data_path("assets/actors"));
+    d.paint = PaintConditions{paint_config_for(Realism::typical), PaintDay::drive};
+    EXPECT_TRUE(same_mesh(before, build_world(d, test::materials(), test::data_path("assets/actors")))) << file;
+    d.paint = PaintConditions{worn(), PaintDay::drive};
+    const World after = build_world(d, test::materials(), test::data_path("assets/actors"));
+    EXPECT_GT(after.paint_materials.size(), 3u) << file;
+    const double share = 1 - paint_area(after) / paint_area(before);
+    EXPECT_GT(share, 0.03) << file;  // the worn share, less the re-painted markings' (and crosswalks')
+    EXPECT_LT(share, 0.2) << file;
+    RecordProperty(osm ? "lanelet2_worn_area_fraction" : "opendrive_worn_area_fraction", std::to_string(share));
+  }
+}
+
 TEST(PaintWear, TheProfilesAndTheScenarioKeys) {
   EXPECT_FALSE(paint_config_for(Realism::ideal).varied);
-  EXPECT_TRUE(paint_config_for(Realism::typical).varied);
+  EXPECT_FALSE(paint_config_for(Realism::typical).varied);  // see PaintConfig::varied
+  EXPECT_TRUE(paint_config_for(Realism::harsh).varied);
   EXPECT_LT(paint_config_for(Realism::harsh).retro_mean_mcd, PaintConfig{}.retro_mean_mcd);
+  // Uniform paint adds nothing to a map's cache key: the maps made before this knob keep theirs.
   EXPECT_EQ(paint_config_for(Realism::ideal).describe_survey(), "");
+  EXPECT_EQ(paint_config_for(Realism::typical).describe_survey(), "");
   // The drive day's changes do not change what the survey saw (the map's cache key).
-  PaintConfig changed;
+  PaintConfig changed = worn();
   changed.faded_fraction = 0.4;
-  EXPECT_EQ(changed.describe_survey(), PaintConfig{}.describe_survey());
+  EXPECT_EQ(changed.describe_survey(), worn().describe_survey());
   changed.worn_fraction = 0.2;
-  EXPECT_NE(changed.describe_survey(), PaintConfig{}.describe_survey());
+  EXPECT_NE(changed.describe_survey(), worn().describe_survey());
 
   const std::string base = "world: campus\nduration_s: 5\nego: {route: {road: loop}}\n";
-  const Scenario s = parse_scenario(base + "paint: {worn_fraction: 0.25, seed: 9}\n", "paint.yaml");
+  const Scenario s = parse_scenario(base + "paint: {varied: true, worn_fraction: 0.25, seed: 9}\n", "paint.yaml");
+  EXPECT_TRUE(s.paint.varied);
   EXPECT_EQ(s.paint.worn_fraction, 0.25);
   EXPECT_EQ(s.paint.seed, 9u);
   EXPECT_FALSE(parse_scenario(base + "realism: ideal\n", "ideal.yaml").paint.varied);
