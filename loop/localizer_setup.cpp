@@ -21,6 +21,7 @@ LoadedScenario load_scenario_and_world(const std::string& path, std::optional<Re
 
 MappingOptions scenario_mapping_options(const Scenario& scenario) {
   MappingOptions options = mapping_options_for(scenario.realism);
+  options.paint = scenario.paint;  // the survey saw the same markings, before the drive day's changes
   if (!scenario.text.empty()) {
     const YamlReader y = YamlReader::from_string(scenario.text, scenario.file);
     if (y.root().IsMap() && y.root()["survey"]) read_survey_options(y, y.root()["survey"], options);

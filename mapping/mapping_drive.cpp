@@ -63,6 +63,8 @@ std::string MappingOptions::describe() const {
     << " point_voxel=" << point_voxel_m << " point_scan_stride=" << point_scan_stride;
   if (ideal_ground) s << " ideal_ground=1";  // absent when off, so typical maps keep their cache key
   if (!curb_label.is_default()) s << " " << curb_label.describe();  // the same
+  // Uniform paint adds nothing, so the maps made before worn paint keep their keys.
+  if (const std::string p = paint.describe_survey(); !p.empty()) s << " " << p;
   return s.str();
 }
 
@@ -74,6 +76,7 @@ MappingOptions mapping_options_for(Realism realism) {
       o.survey_error.heading_sigma_rad = 0;
       o.survey_unit_serial = Hdl32eConfig{}.unit_serial;  // the test car's own unit
       o.ideal_ground = true;
+      o.paint = paint_config_for(realism);
       break;
     case Realism::typical:
       break;  // the defaults: an RTK-INS survey (SurveyErrorConfig)
@@ -89,6 +92,7 @@ MappingOptions mapping_options_for(Realism realism) {
       // of a survey cloud at the curb; no published figure found).
       o.curb_label.convention = CurbLabel::face_top;
       o.curb_label.noise_m = 0.03;
+      o.paint = paint_config_for(realism);
       break;
   }
   return o;
@@ -97,6 +101,7 @@ MappingOptions mapping_options_for(Realism realism) {
 LoadedWorld load_mapped_world(const std::string& world, const MappingOptions& options) {
   WorldDescription description = load_world_description_of(world);
   if (options.ideal_ground) description = on_ideal_ground(std::move(description));
+  description.paint = PaintConditions{options.paint, PaintDay::survey};
   return build_loaded_world(std::move(description));
 }
 

@@ -41,6 +41,9 @@ struct MappingOptions {
   // Map the world on ideal ground (flat roads, ideal curbs: on_ideal_ground), as the `ideal` profile's
   // car drives it.
   bool ideal_ground = false;
+  // The markings' wear on the survey day (sim/paint_wear.hpp): a scenario's `paint`, as it was before
+  // the changes the drive day shows.
+  PaintConfig paint;
   // The point-cloud layer's voxel, m: one point (the centroid) per voxel. 0.4 m keeps the surfaces a
   // GICP needs (curb faces, walls, poles of 0.1-0.3 m are one voxel thick) at about a quarter of the
   // points of 0.2 m, and divides the intensity tiles' 64 m into whole voxels (160), so both layers
@@ -60,7 +63,8 @@ struct MappingOptions {
 // (see mapping_drive.cpp for the figures).
 MappingOptions mapping_options_for(Realism realism);
 
-// The world a map with these options is built from: the world file, on ideal ground if options say so.
+// The world a map with these options is built from: the world file, on ideal ground if options say so,
+// with the paint of the survey day.
 LoadedWorld load_mapped_world(const std::string& world, const MappingOptions& options);
 
 // Overrides of the survey settings from a YAML mapping: unit_serial, provenance (rtk_ins or slam; the

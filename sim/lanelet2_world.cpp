@@ -343,7 +343,8 @@ struct Builder {
   Lanelet2BuildReport& report;
   Lanelet2Standards std_;
   World world;
-  region::Paths motor;  // road lanelets alone, without bicycle lanes
+  MarkingPainter painter{params.paint, materials};  // each marking's wear (uniform without params.paint)
+  region::Paths motor;                              // road lanelets alone, without bicycle lanes
   std::shared_ptr<const EdgeField> edges;
   std::shared_ptr<const RaisedEdges> raised;
   std::function<double(const Eigen::Vector2d&)> terrain;
@@ -662,8 +663,8 @@ struct Builder {
     const double z = params.geometry.paint_height;
     const auto g = [this](const Eigen::Vector2d& p) { return ground(p); };
     auto strip = [&](const Polyline2d& line, double width, bool dashed, double dash, double gap, MaterialId m) {
-      if (!dashed) return add_paint_line(world.mesh, line, width / 2, g, z, m);
-      for (const auto& piece : dashes(line, dash, gap)) add_paint_line(world.mesh, piece, width / 2, g, z, m);
+      if (!dashed) return add_paint_line(world.mesh, line, width / 2, g, z, m, &painter);
+      for (const auto& piece : dashes(line, dash, gap)) add_paint_line(world.mesh, piece, width / 2, g, z, m, &painter);
     };
     std::set<Lanelet2Id> zebra_done;
     // Zebra crossings: between the two zebra_marking bounds of a lanelet, stripes across it from one
@@ -724,8 +725,8 @@ struct Builder {
         const double len = polyline_length(line), period = std_.zebra_stripe + std_.zebra_gap;
         for (double s0 = std_.zebra_stripe / 2; s0 <= len; s0 += period) {
           const PolylineSample at = sample_polyline(line, s0);
-          add_paint_quad(world.mesh, at.point, left_normal(at.tangent), std_.zebra_length / 2, std_.zebra_stripe / 2, g,
-                         z, zebra);
+          add_marking_quad(world.mesh, at.point, left_normal(at.tangent), std_.zebra_length / 2, std_.zebra_stripe / 2,
+                           g, z, zebra, painter);
           ++report.zebra_stripes;
         }
         ++report.not_built["zebra_marking with no partner bound: stripes centred on it"];
@@ -739,12 +740,16 @@ struct Builder {
               const Ground& g, double z, MaterialId m) {
     const int pieces = std::max(1, int(std::ceil(std::max((d - a).norm(), (c - b).norm()) / kPaintPiece)));
     const auto base = static_cast<uint32_t>(world.mesh.vertices.size());
+    bool fresh = false;  // one marking: its own paint (sim/paint_wear.hpp), worn in pieces
+    m = painter.marking(m, marking_key(0.25 * (a + b + c + d)), fresh);
     for (int k = 0; k <= pieces; ++k) {
       const double f = double(k) / pieces;
       for (const Eigen::Vector2d& p : {Eigen::Vector2d(a + (d - a) * f), Eigen::Vector2d(b + (c - b) * f)})
         world.mesh.vertices.emplace_back(float(p.x()), float(p.y()), float(g(p) + z));
     }
     for (uint32_t k = 0; k < uint32_t(pieces); ++k) {
+      const double f = (k + 0.5) / pieces;
+      if (painter.worn(0.5 * (a + (d - a) * f + b + (c - b) * f), fresh)) continue;
       world.mesh.add_triangle(base + 2 * k, base + 2 * k + 1, base + 2 * k + 3, m);
       world.mesh.add_triangle(base + 2 * k, base + 2 * k + 3, base + 2 * k + 2, m);
     }
@@ -1068,6 +1073,7 @@ World build_lanelet2_world(const Lanelet2Map& map, const Lanelet2WorldParams& pa
   b.parking();
   b.poles();
   b.not_built();
+  b.world.paint_materials = b.painter.variants();
   return std::move(b.world);
 }
 

@@ -120,6 +120,9 @@ struct Lanelet2WorldParams {
   // Traffic lights with no height in the map: housing bottom 2.4 m above the ground (MUTCD 4D.15: at
   // least 8 ft over a sidewalk), housing 0.9 m tall (three 200 mm lenses, EN 12368).
   double light_bottom = 2.4, light_height = 0.9;
+  // The markings' wear (sim/paint_wear.hpp): not a key of the world file; build_world sets it from the
+  // world's description (a scenario's `paint`). Unset: uniform paint.
+  std::optional<PaintConditions> paint;
 };
 
 struct Lanelet2BuildReport {

@@ -30,6 +30,12 @@ MaterialTable MaterialTable::load(const std::string& path) {
   return table;
 }
 
+void MaterialTable::append(const std::vector<Material>& variants) {
+  if (materials_.size() + variants.size() > std::numeric_limits<MaterialId>::max())
+    throw InputError(file_ + ": too many materials with the world's paint variants");
+  materials_.insert(materials_.end(), variants.begin(), variants.end());
+}
+
 bool MaterialTable::contains(const std::string& name) const {
   for (const auto& m : materials_)
     if (m.name == name) return true;

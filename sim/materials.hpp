@@ -23,6 +23,9 @@ class MaterialTable {
   const Material& operator[](MaterialId id) const { return materials_[id]; }
   size_t size() const { return materials_.size(); }
   const std::string& file() const { return file_; }
+  // Materials made while building a world (sim/paint_wear.hpp: a marking's paint with its own
+  // reflectivity, under the paint's name), after the file's own: ids size(), size() + 1, ...
+  void append(const std::vector<Material>& variants);
 
  private:
   std::string file_;

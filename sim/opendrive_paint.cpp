@@ -74,7 +74,7 @@ Polyline2d edge_line(const OdrRoad& road, size_t section, int lane_id, double s0
 
 void paint_lane(const OdrRoad& road, size_t section, const OdrLane& lane, const OdrWorldParams& p,
                 const std::function<double(const Eigen::Vector2d&)>& ground, MaterialId paint, TriangleMesh& mesh,
-                OdrBuildReport& report) {
+                OdrBuildReport& report, MarkingPainter& painter) {
   const double sec_s = road.sections[section].s, sec_end = road.section_end(section);
   for (size_t k = 0; k < lane.marks.size(); ++k) {
     const OdrRoadMark& m = lane.marks[k];
@@ -100,13 +100,14 @@ void paint_lane(const OdrRoad& road, size_t section, const OdrLane& lane, const 
         const double length = polyline_length(line);
         for (double at = 0; at <= length; at += l.gap) {
           const PolylineSample q = sample_polyline(line, at);
-          add_paint_quad(mesh, q.point, q.tangent, l.width / 2, l.width / 2, ground, p.geometry.paint_height, paint);
+          add_marking_quad(mesh, q.point, q.tangent, l.width / 2, l.width / 2, ground, p.geometry.paint_height, paint,
+                           painter);
         }
       } else if (l.gap > 0) {
         for (const auto& piece : dashes(line, l.dash, l.gap))
-          add_paint_line(mesh, piece, l.width / 2, ground, p.geometry.paint_height, paint);
+          add_paint_line(mesh, piece, l.width / 2, ground, p.geometry.paint_height, paint, &painter);
       } else {
-        add_paint_line(mesh, line, l.width / 2, ground, p.geometry.paint_height, paint);
+        add_paint_line(mesh, line, l.width / 2, ground, p.geometry.paint_height, paint, &painter);
       }
     }
     ++report.paint[m.type + (m.color.empty() || m.color == "standard" ? "" : " " + m.color)];
@@ -116,7 +117,7 @@ void paint_lane(const OdrRoad& road, size_t section, const OdrLane& lane, const 
 // Stripes parallel to the road (the traffic's direction at the object), spaced across the outline.
 void paint_crosswalk(const OdrRoad& road, const OdrObject& o, const OdrWorldParams& p,
                      const std::function<double(const Eigen::Vector2d&)>& ground, MaterialId paint, TriangleMesh& mesh,
-                     OdrBuildReport& report) {
+                     OdrBuildReport& report, MarkingPainter& painter) {
   const Polyline2d outline = object_outline(road, o);
   if (outline.size() < 3) {
     ++report.not_built["crosswalk without an outline or a size"];
@@ -139,8 +140,12 @@ void paint_crosswalk(const OdrRoad& road, const OdrObject& o, const OdrWorldPara
     const region::Paths stripe = region::intersect(
         region::rectangle(centre, u, 0.5 * (u1 - u0) + kStripeOverhang, p.crosswalk_stripe / 2), area);
     if (stripe.empty()) continue;
+    // Each stripe its own paint (sim/paint_wear.hpp); clipped to the outline, it is meshed whole, so it
+    // has no worn patches.
+    bool fresh = false;
+    const MaterialId look = painter.marking(paint, marking_key(centre), fresh);
     region::mesh_region(
-        stripe, kStripeTile, [&](const Eigen::Vector2d& q) { return float(ground(q) + z); }, paint, mesh, kStripeTile);
+        stripe, kStripeTile, [&](const Eigen::Vector2d& q) { return float(ground(q) + z); }, look, mesh, kStripeTile);
     ++report.crosswalk_stripes;
   }
   ++report.crosswalks;
@@ -172,16 +177,16 @@ Polyline2d object_outline(const OdrRoad& road, const OdrObject& o) {
 
 void paint_opendrive(const OdrMap& map, const OdrWorldParams& params,
                      const std::function<double(const Eigen::Vector2d&)>& ground, MaterialId lane_paint,
-                     MaterialId crosswalk_paint, TriangleMesh& mesh, OdrBuildReport& report) {
+                     MaterialId crosswalk_paint, TriangleMesh& mesh, OdrBuildReport& report, MarkingPainter& painter) {
   for (const auto& road : map.roads) {
     for (size_t i = 0; i < road.sections.size(); ++i) {
       const OdrLaneSection& sec = road.sections[i];
-      paint_lane(road, i, sec.center, params, ground, lane_paint, mesh, report);
+      paint_lane(road, i, sec.center, params, ground, lane_paint, mesh, report, painter);
       for (const auto* side : {&sec.left, &sec.right})
-        for (const auto& lane : *side) paint_lane(road, i, lane, params, ground, lane_paint, mesh, report);
+        for (const auto& lane : *side) paint_lane(road, i, lane, params, ground, lane_paint, mesh, report, painter);
     }
     for (const auto& o : road.objects)
-      if (o.type == "crosswalk") paint_crosswalk(road, o, params, ground, crosswalk_paint, mesh, report);
+      if (o.type == "crosswalk") paint_crosswalk(road, o, params, ground, crosswalk_paint, mesh, report, painter);
   }
 }
 

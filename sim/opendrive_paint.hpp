@@ -11,7 +11,7 @@ namespace lidarloop {
 // `ground` is the height paint lies on (the pavement, else the raised ground).
 void paint_opendrive(const OdrMap& map, const OdrWorldParams& params,
                      const std::function<double(const Eigen::Vector2d&)>& ground, MaterialId lane_paint,
-                     MaterialId crosswalk_paint, TriangleMesh& mesh, OdrBuildReport& report);
+                     MaterialId crosswalk_paint, TriangleMesh& mesh, OdrBuildReport& report, MarkingPainter& painter);
 
 // The outline of an object in the map's x / y: its outline's corners (road or local frame), else its
 // length x width box; empty when it has neither.

@@ -438,7 +438,10 @@ World build_opendrive_world(const OdrMap& map, const OdrWorldParams& params, con
   b.surfaces();
   b.regions_and_ground();
   b.curbs();
-  paint_opendrive(map, params, b.surface_at, b.mat("lane_paint"), b.mat("crosswalk_paint"), b.world.mesh, b.report);
+  MarkingPainter painter(params.paint, materials);
+  paint_opendrive(map, params, b.surface_at, b.mat("lane_paint"), b.mat("crosswalk_paint"), b.world.mesh, b.report,
+                  painter);
+  b.world.paint_materials = painter.variants();
   b.parking();
   b.objects();
   for (const auto& w : map.warnings) b.report.warnings.push_back(w);

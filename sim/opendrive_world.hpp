@@ -46,6 +46,9 @@
 namespace lidarloop {
 
 struct OdrWorldParams {
+  // The markings' wear (sim/paint_wear.hpp): not a key of the world file; build_world sets it from the
+  // world's description (a scenario's `paint`). Unset: uniform paint.
+  std::optional<PaintConditions> paint;
   // Paint height, roughness (ISO 8608 class, seed), margin round the map: as the generated worlds.
   WorldGeometryParams geometry;
   // A sidewalk (or curb) lane without a `height`, and a lane outside a curb mark: raised this much above

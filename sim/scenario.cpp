@@ -330,6 +330,8 @@ Scenario parse(const YamlReader& y, const VehicleParams& vehicle, std::optional<
   read_body_config(y, root["body"], s.body);
   s.weather = weather_config_for(s.realism);
   if (const YAML::Node n = root["weather"]) read_weather_config(y, n, s.weather);
+  s.paint = paint_config_for(s.realism);
+  if (const YAML::Node n = root["paint"]) read_paint_config(y, n, s.paint);
   s.mount_error = mount_error_config_for(s.realism);
   read_mount_error(y, root["mount_error"], s.mount_error);
   s.clocks = clock_config_for(s.realism);
@@ -521,8 +523,8 @@ std::vector<std::string> realism_overrides(const Scenario& scenario) {
   if (!root.IsMap()) return out;
   for (const auto& kv : root) {
     const std::string key = kv.first.Scalar();
-    for (const char* section : {"lidar", "body", "weather", "clocks", "mount_error", "can", "gps", "rtk", "survey",
-                                "world_changes", "reference"})
+    for (const char* section : {"lidar", "body", "weather", "paint", "clocks", "mount_error", "can", "gps", "rtk",
+                                "survey", "world_changes", "reference"})
       if (key == section) list_scalars(kv.second, key, out);
   }
   return out;

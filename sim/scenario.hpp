@@ -13,6 +13,7 @@
 #include "sim/controller.hpp"
 #include "sim/gps_model.hpp"
 #include "sim/hdl32e.hpp"
+#include "sim/paint_wear.hpp"
 #include "sim/path.hpp"
 #include "sim/realism.hpp"
 #include "sim/sensor_calibration.hpp"
@@ -184,6 +185,7 @@ struct Scenario {
   RtkConfig rtk;
   BodyConfig body;               // the ego's suspension (`body`)
   WeatherConfig weather;         // the day the scenario is driven on (the map was surveyed on a dry one)
+  PaintConfig paint;             // the markings' wear, on the survey day and today (`paint`)
   MountErrorConfig mount_error;  // the true LiDAR mount and GPS antenna against the nominal `lidar` / `gps` ones
   ClockConfig clocks;            // the LiDAR's and the CAN's stamping clocks against the reference
   std::vector<TrafficSpec> traffic;
@@ -209,7 +211,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& name, c
                         std::optional<Realism> realism = std::nullopt);
 
 // The realism knobs the scenario sets itself, on top of its profile: every scalar under the sections
-// that hold knobs (lidar, body, weather, clocks, mount_error, can, gps, rtk, survey, world_changes,
+// that hold knobs (lidar, body, weather, paint, clocks, mount_error, can, gps, rtk, survey, world_changes,
 // reference), as "section.key = value" in file order, so a report can say how a run differs from its profile.
 std::vector<std::string> realism_overrides(const Scenario& scenario);
 

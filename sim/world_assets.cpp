@@ -47,6 +47,7 @@ WorldDescription load_world_description_of(const std::string& name_or_path) {
 LoadedWorld build_loaded_world(WorldDescription description) {
   MaterialTable materials = MaterialTable::load(data_dir() + "/assets/materials.yaml");
   World world = build_world(description, materials, actors_dir());
+  materials.append(world.paint_materials);
   return {std::move(materials), std::move(description), std::move(world)};
 }
 
@@ -63,6 +64,7 @@ LoadedWorld load_scenario_world(const Scenario& scenario) {
     const YAML::Node changes = y.root().IsMap() ? y.root()["world_changes"] : YAML::Node();
     if (changes) description = apply_world_changes(std::move(description), y, changes);
   }
+  description.paint = PaintConditions{scenario.paint, PaintDay::drive};  // today's paint, changed since the survey
   return build_loaded_world(std::move(description));
 }
 

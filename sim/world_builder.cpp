@@ -164,7 +164,8 @@ struct Builder {
   const MaterialTable& materials;
   const std::string& actors_dir;
   World world;
-  region::Paths no_lane_paint;  // intersections and crosswalk approaches
+  region::Paths no_lane_paint;                    // intersections and crosswalk approaches
+  MarkingPainter painter{desc.paint, materials};  // each marking's wear (uniform without desc.paint)
 
   MaterialId mat(const std::string& name) const { return materials.id(name, desc.file); }
 
@@ -256,7 +257,8 @@ struct Builder {
       for (int k = 0; k < stripes; ++k) {
         const double lateral = (k - (stripes - 1) / 2.0) * period;
         const Eigen::Vector2d centre = s.point + n * lateral;
-        add_paint_quad(world.mesh, centre, s.tangent, c.width / 2, g.crosswalk_stripe / 2, pavement, z, zebra);
+        add_marking_quad(world.mesh, centre, s.tangent, c.width / 2, g.crosswalk_stripe / 2, pavement, z, zebra,
+                         painter);
       }
     }
     for (const auto& sl : desc.stop_lines) {
@@ -266,7 +268,8 @@ struct Builder {
       const double inset = g.edge_line_inset + road.gutter_width;
       const double lo = sl.side == RoadSide::left ? 0.0 : -road.width / 2 + inset;
       const double hi = sl.side == RoadSide::right ? 0.0 : road.width / 2 - inset;
-      add_paint_line(world.mesh, {s.point + n * lo, s.point + n * hi}, g.stop_line_width / 2, pavement, z, lane);
+      add_paint_line(world.mesh, {s.point + n * lo, s.point + n * hi}, g.stop_line_width / 2, pavement, z, lane,
+                     &painter);
     }
     // Where the paint changed since the survey (a scenario's world_changes): today's lines there are
     // gone, or redrawn `shift` to the left.
@@ -296,7 +299,8 @@ struct Builder {
               for (const auto& dash : dashes(line, g.dash_length, g.dash_gap)) pieces.push_back(dash);
           }
           if (!worn.empty()) pieces = region::clip_lines_outside(pieces, worn);
-          for (const auto& piece : pieces) add_paint_line(world.mesh, piece, g.paint_width / 2, pavement, z, lane);
+          for (const auto& piece : pieces)
+            add_paint_line(world.mesh, piece, g.paint_width / 2, pavement, z, lane, &painter);
         }
       };
       paint(road.centreline, road.closed, 0, changed);
@@ -546,8 +550,9 @@ World build_world(const WorldDescription& description, const MaterialTable& mate
   Builder b{description, materials, actors_dir, {}, {}};
   if (description.opendrive) {  // as a Lanelet2 map's below
     OdrBuildReport report;
-    b.world = build_opendrive_world(description.opendrive->map, description.opendrive->params, materials, actors_dir,
-                                    &report);
+    OdrWorldParams params = description.opendrive->params;
+    params.paint = description.paint;
+    b.world = build_opendrive_world(description.opendrive->map, params, materials, actors_dir, &report);
     b.world.name = description.name;
     b.world.import_report = report.summary();
     b.build_buildings();
@@ -557,8 +562,9 @@ World build_world(const WorldDescription& description, const MaterialTable& mate
   if (description.lanelet2) {
     // The road network is the map's; what the world file adds stands on it.
     Lanelet2BuildReport report;
-    b.world =
-        build_lanelet2_world(description.lanelet2->map, description.lanelet2->params, materials, actors_dir, &report);
+    Lanelet2WorldParams params = description.lanelet2->params;
+    params.paint = description.paint;
+    b.world = build_lanelet2_world(description.lanelet2->map, params, materials, actors_dir, &report);
     b.world.name = description.name;
     b.world.import_report = report.summary();
     b.build_buildings();
@@ -572,6 +578,7 @@ World build_world(const WorldDescription& description, const MaterialTable& mate
   b.build_ground();
   b.build_markings();
   b.build_objects();
+  b.world.paint_materials = b.painter.variants();
   return std::move(b.world);
 }
 

@@ -37,6 +37,9 @@ struct World {
   // A world imported from a map: what was built of it and what not (sim/lanelet2_world.hpp); empty for
   // a generated world.
   std::string import_report;
+  // The markings' own paint materials (sim/paint_wear.hpp), to be appended to the table the world was
+  // built with (MaterialTable::append): its triangles use their ids. Empty for uniform paint.
+  std::vector<Material> paint_materials;
 
   CurbMap curb_map() const { return {origin, name, curbs, curb_kinds}; }
   // What stands on the world: the pavement on the carriageway, the raised ground elsewhere. The

@@ -4,12 +4,14 @@
 // Loading validates everything that can be checked without building geometry; every error names the
 // file, line and column.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/curb_map_file.hpp"
 #include "common/geodetic.hpp"
 #include "common/yaml_reader.hpp"
+#include "sim/paint_wear.hpp"
 
 namespace lidarloop {
 
@@ -199,6 +201,10 @@ struct WorldDescription {
   std::vector<HedgeSpec> hedges;
   std::vector<ParkedVehicleSpec> parked;
   std::vector<PaintChange> paint_changes;  // a world file has none: see apply_world_changes
+  // The markings' wear (sim/paint_wear.hpp) and the day they are seen on; a world file has none
+  // (uniform paint): a scenario's `paint` sets it for the drive (load_scenario_world) and the map's
+  // survey (load_mapped_world).
+  std::optional<PaintConditions> paint;
   std::vector<ConstructionZone> construction;
   // The road network read from a Lanelet2 map instead of `roads` (world.yaml's `lanelet2`, or a map
   // file given as the world): roads, and everything placed along them, are then empty.

@@ -27,6 +27,22 @@ TEST(RealismProfiles, EachProfileSurveysItsOwnMap) {
   EXPECT_NE(harsh.describe(), typical.describe());
 }
 
+// The survey's paint is in the map's cache key; the drive day's changes to it are not (the map is the same).
+TEST(RealismProfiles, TheSurveysPaintIsInTheMapsCacheKey) {
+  MappingOptions worn;
+  worn.paint.varied = true;
+  EXPECT_NE(worn.describe(), MappingOptions{}.describe());
+  MappingOptions faded = worn;
+  faded.paint.faded_fraction = 0.5;
+  faded.paint.repainted_fraction = 0.3;
+  EXPECT_EQ(faded.describe(), worn.describe());
+  MappingOptions more_worn = worn;
+  more_worn.paint.worn_fraction = 0.3;
+  EXPECT_NE(more_worn.describe(), worn.describe());
+  EXPECT_TRUE(mapping_options_for(Realism::harsh).paint.varied);
+  EXPECT_FALSE(mapping_options_for(Realism::typical).paint.varied);
+}
+
 TEST(RealismProfiles, TheIdealMapsWorldIsOnIdealGround) {
   const LoadedWorld typical = load_mapped_world("campus", mapping_options_for(Realism::typical));
   const LoadedWorld ideal = load_mapped_world("campus", mapping_options_for(Realism::ideal));
