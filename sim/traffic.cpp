@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
 
 namespace lidarloop {
 
@@ -45,8 +46,15 @@ ActorPoses actor_motion(std::vector<ActorPlan> actors, GroundHeight ground) {
   bool moving = false;
   for (const auto& a : actors) moving = moving || a.speed > 0;
   if (!moving) return {};
-  return [actors = std::move(actors), ground = std::move(ground)](int64_t t_ns, std::vector<Eigen::Isometry3d>& poses) {
-    for (size_t i = 0; i < actors.size(); ++i) poses[i] = actor_pose(actors[i], t_ns, ground);
+  // A parked actor's pose is worked out once: the ground under it is a point-in-polygon test against the
+  // whole carriageway, which, asked for hundreds of parked cars at every keyframe of every scan, was
+  // most of a busy street's simulation time.
+  std::vector<std::optional<Eigen::Isometry3d>> parked(actors.size());
+  for (size_t i = 0; i < actors.size(); ++i)
+    if (actors[i].speed <= 0) parked[i] = actor_pose(actors[i], 0, ground);
+  return [actors = std::move(actors), ground = std::move(ground), parked = std::move(parked)](
+             int64_t t_ns, std::vector<Eigen::Isometry3d>& poses) {
+    for (size_t i = 0; i < actors.size(); ++i) poses[i] = parked[i] ? *parked[i] : actor_pose(actors[i], t_ns, ground);
   };
 }
 
