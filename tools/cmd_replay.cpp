@@ -138,13 +138,14 @@ int run_replay(const Args& args) {
               (unsigned long long)scenario.seed, recorded_method.empty() ? "no localizer" : recorded_method.c_str());
   std::printf("latency    %s\n", latency_text(scored.metrics).c_str());
   std::printf("curbs      %s\n", curb_occlusion_text(scored.metrics).c_str());
+  std::cout << integrity_lines(scored.metrics);
   std::cout << reference_lines(scored.metrics);
   if (method == recorded_method) compare_statuses(log, recorded_statuses, estimates);
   for (const auto& f : scored.metrics.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
-      "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
+      "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum%s, junit.xml, errors.png, "
       "trajectory.png)\n",
-      scored.metrics.pass ? "PASS" : "FAIL", out.c_str());
+      scored.metrics.pass ? "PASS" : "FAIL", out.c_str(), scored.metrics.reference ? ", reference.tum" : "");
   if (!failure.empty()) throw InputError(failure + " (the replay's results are in " + out + "/, failed)");
   return scored.metrics.pass ? 0 : 1;
 }

@@ -159,9 +159,9 @@ int run_run(const Args& args) {
   std::cout << reference_lines(m);
   for (const auto& f : m.failures) std::printf("FAILED     %s\n", f.c_str());
   std::printf(
-      "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum, junit.xml, errors.png, "
+      "result     %s\nfiles      %s/ (metrics.json, errors.csv, estimate.tum, truth.tum%s, junit.xml, errors.png, "
       "trajectory.png, worst_frame.png)\n",
-      m.pass ? "PASS" : "FAIL", out.c_str());
+      m.pass ? "PASS" : "FAIL", out.c_str(), m.reference ? ", reference.tum" : "");
   if (!trace.failure.empty()) throw InputError(trace.failure + " (the run's results are in " + out + "/, failed)");
   return m.pass ? 0 : 1;
 }
