@@ -41,6 +41,8 @@ SUITE = ["static_campus", "dynamic_campus", "bus_occlusion", "straight_road", "i
          "closed_loop_campus", "changed_world", "kidnap", "gps_jump_parked", "cold_start_parked",
          "busy_street"]
 PAPER_SCENARIOS = [("static", "static_campus", "Table II"), ("dynamic", "dynamic_campus", "Table III")]
+# The same tables on drives of the paper's length (4513 frames) on a map of its size (the large world).
+PAPER_LENGTH_SCENARIOS = [("static", "paper_static_large", "Table II"), ("dynamic", "paper_dynamic_large", "Table III")]
 GICP_SCENARIOS = ["static_campus", "dynamic_campus", "bus_occlusion"]
 # Integrity over many seeds: the scenarios, the seeds (LIDARLOOP_INTEGRITY_SEEDS, a compare --seeds list)
 # and the methods (LIDARLOOP_INTEGRITY_METHODS; by default the paper's: gicp, beyond the paper and the
@@ -176,9 +178,9 @@ def target_large(r, commands):
         f"{peak:.0f} MB. What `map` printed:\n\n```text\n{built.strip()}\n```\n")}
 
 
-def paper_tables(r, commands, realism):
+def paper_tables(r, commands, realism, scenarios=PAPER_SCENARIOS):
     parts = []
-    for paper, scenario, title in PAPER_SCENARIOS:
+    for paper, scenario, title in scenarios:
         out = fresh(os.path.join(WORK, "paper" + ("-" + realism if realism else ""), scenario))
         args = ["lidarloop", "compare", f"scenarios/{scenario}.yaml", "--seeds", "1-5", "--paper", paper]
         if realism:
@@ -197,6 +199,11 @@ def target_paper(r, commands):
 
 def target_harsh(r, commands):
     return {"paper-harsh": paper_tables(r, commands, "harsh")}
+
+
+def target_paper_length(r, commands):
+    return {"paper-length": paper_tables(r, commands, None, PAPER_LENGTH_SCENARIOS),
+            "paper-length-harsh": paper_tables(r, commands, "harsh", PAPER_LENGTH_SCENARIOS)}
 
 
 def target_gicp(r, commands):
@@ -550,6 +557,9 @@ TARGETS = {
               "Tables II and III: compare --seeds 1-5 --paper static|dynamic (typical)"),
     "harsh": (target_harsh, {"paper-harsh": "docs/paper-experiment.md"},
               "Tables II and III under --realism harsh"),
+    "paper-length": (target_paper_length,
+                     {"paper-length": "docs/paper-experiment.md", "paper-length-harsh": "docs/paper-experiment.md"},
+                     "Tables II and III on the paper-length drives of the large world, typical and harsh (hours)"),
     "gicp": (target_gicp, {"gicp": "docs/localizer.md"},
              "proposed against gicp on static_campus, dynamic_campus, bus_occlusion (one seed each)"),
     "street": (target_street, {"street": "docs/scenarios.md"},
