@@ -14,7 +14,8 @@ constexpr double kOriginTolerance = 1e-9;  // deg, ~0.1 mm: both layers must sha
 // A curb map surveyed with the intensity layer lies on the same streets, so within the extent of its
 // tiles; one tile of slack is kept for a curb drawn just past the last surveyed cell. A vertex farther
 // out is a curb map of another place (or a corrupt one), and densifying a line that runs off for
-// hundreds of kilometres would take minutes and gigabytes before anything could say so.
+// hundreds of kilometres into points 10 cm apart takes seconds (222 km: 2.2 million points, 3.6 s under
+// AddressSanitizer), and across a continent minutes and gigabytes, before anything could say so.
 static void check_curbs_within_tiles(const CurbMap& curbs, const IntensityMapHeader& h, const std::string& curbs_file,
                                      const std::string& header_file) {
   if (h.tiles.empty()) return;
