@@ -100,20 +100,20 @@ double Path::curvature_at(double s) const {
   return span > 0 ? wrap_angle(b - a) / span : 0.0;
 }
 
-Path lane_path(const RoadSpec& road, Lane lane, bool backward, const double* offset) {
+double lane_offset(const RoadSpec& road, Lane lane, bool backward) {
+  const double lane_width = road.width / road.lanes;
+  const double outer = road.width / 2 - lane_width / 2;  // the lane along the curb
   double lateral = 0;
-  if (offset) {
-    lateral = *offset;
-  } else {
-    const double lane_width = road.width / road.lanes;
-    const double outer = road.width / 2 - lane_width / 2;  // the lane along the curb
-    if (road.one_way)
-      lateral = lane == Lane::right ? -outer : outer;
-    else
-      lateral = lane == Lane::right ? -outer : -(road.lanes >= 2 ? lane_width / 2 : outer);
-    if (road.lanes == 1 && !road.one_way) lateral = 0;
-    if (backward) lateral = -lateral;
-  }
+  if (road.one_way)
+    lateral = lane == Lane::right ? -outer : outer;
+  else
+    lateral = lane == Lane::right ? -outer : -(road.lanes >= 2 ? lane_width / 2 : outer);
+  if (road.lanes == 1 && !road.one_way) lateral = 0;
+  return backward ? -lateral : lateral;
+}
+
+Path lane_path(const RoadSpec& road, Lane lane, bool backward, const double* offset) {
+  const double lateral = offset ? *offset : lane_offset(road, lane, backward);
   Polyline2d line = offset_polyline(road.centreline, lateral, road.closed);
   if (backward) std::reverse(line.begin(), line.end());
   return make_path(std::move(line), road.closed);

@@ -38,6 +38,9 @@ enum class Lane { right, left };  // in the direction of travel
 // road they are its outermost lanes. `offset`, if set, overrides the lane with a lateral offset (m,
 // positive = left of the centreline's direction).
 Path lane_path(const RoadSpec& road, Lane lane, bool backward, const double* offset = nullptr);
+// The lateral offset of that lane's centre from the centreline (m, positive = left of the centreline's
+// direction), as lane_path takes it without `offset`.
+double lane_offset(const RoadSpec& road, Lane lane, bool backward);
 
 // A pedestrian's line across a road at a crosswalk, from the right sidewalk to the left one.
 Path crosswalk_path(const RoadSpec& road, const CrosswalkSpec& crosswalk, bool from_left);

@@ -228,8 +228,7 @@ struct Builder {
   // stop and back after it, sampled along the whole road, in its direction of travel.
   Path bus_line(const BusStopSpec& b, const RoadRef& r) const {
     const RoadSpec& road = *r.road;
-    const double lane_width = road.width / road.lanes;
-    const double lane = road.lanes == 1 && !road.one_way ? 0.0 : road.width / 2 - lane_width / 2;
+    const double lane = std::abs(lane_offset(road, Lane::right, false));  // the curb lane's, on either side
     const double curb = road.width / 2 - b.curb_gap_m - actor_footprint(ActorType::bus).width / 2;
     const double hold = actor_footprint(ActorType::bus).length / 2;
     Polyline2d line;

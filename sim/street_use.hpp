@@ -51,7 +51,7 @@ struct SidewalkPedestrianConfig {
   std::vector<StreetStretch> stretches;
   double per_100m = 0;  // on each side of each stretch; set by the scenario (no single source fits a street)
   // Knoblauch, Pietrucha and Nitzburg, TRR 1538 (1996): mean walking speeds 1.51 m/s (under 65) and
-  // 1.25 m/s (65 and over); their middle, with a spread that covers both groups.
+  // 1.25 m/s (65 and over); their middle. The spread is an assumption: wide enough to cover both groups.
   double speed_mps = 1.38;
   double speed_sigma_mps = 0.2;
   double from_curb_m = 1.0;  // behind the curb line, m (an assumption: the sidewalk's kerbside half)
@@ -75,6 +75,7 @@ struct CyclistConfig {
   std::vector<StreetStretch> stretches;
   double per_km = 0;  // on each side of each stretch; set by the scenario
   // El-Geneidy, Krizek and Iacono (2007), Minneapolis GPS traces: mean commuting speed about 16 km/h.
+  // The spread between riders is an assumption (about 3 km/h).
   double speed_mps = 4.5;
   double speed_sigma_mps = 0.8;
   // The cyclist's centre from the curb face (an assumption: riders keep 0.5-1 m off the curb, as
