@@ -142,6 +142,11 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
       actor_poses(stamp_ns + k * keyframe_step_ns_, poses);
       for (size_t a = 0; a < poses.size(); ++a) motion[a].push_back(poses[a]);
     }
+    // An actor standing still is one pose, not a motion: Embree then traverses it as a static
+    // instance, not through a motion-blur BVH (a parked street's hundreds of cars).
+    for (auto& m : motion)
+      if (std::all_of(m.begin(), m.end(), [&](const Eigen::Isometry3d& p) { return p.isApprox(m.front(), 0); }))
+        m.resize(1);
     for (size_t a = 0; a < motion.size(); ++a) scene.set_actor_motion(int(a), motion[a]);
     scene.commit();
     if (weather_.spray && weather_.wet) spray = spray_boxes(motion);

@@ -1,5 +1,6 @@
 #include "sim/region.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <unordered_map>
@@ -215,6 +216,61 @@ bool contains(const Paths& region, const Eigen::Vector2d& p) {
   int winding = 0;
   for (const auto& path : region)
     if (ClipperLib::PointInPolygon(q, path) != 0) winding += ClipperLib::Orientation(path) ? 1 : -1;
+  return winding > 0;
+}
+
+ContainsIndex::ContainsIndex(const Paths& region, double band_m)
+    : band_(std::max<cInt>(1, std::llround(band_m * kScale))) {
+  cInt min_y = INT64_MAX, max_y = INT64_MIN;
+  for (const auto& path : region)
+    for (const auto& p : path) min_y = std::min(min_y, p.Y), max_y = std::max(max_y, p.Y);
+  if (min_y > max_y) return;
+  y0_ = min_y;
+  bands_.resize(size_t((max_y - min_y) / band_) + 1);
+  for (size_t k = 0; k < region.size(); ++k) {
+    const Path& path = region[k];
+    path_sign_.push_back(ClipperLib::Orientation(path) ? 1 : -1);
+    if (path.size() < 3) continue;  // PointInPolygon's answer for it is always 0
+    for (size_t i = 0; i < path.size(); ++i) {
+      const IntPoint& a = path[i];
+      const IntPoint& b = path[(i + 1) % path.size()];
+      const cInt lo = std::min(a.Y, b.Y), hi = std::max(a.Y, b.Y);
+      for (cInt band = (lo - y0_) / band_; band <= (hi - y0_) / band_; ++band)
+        bands_[size_t(band)].push_back({a, b, int(k)});
+    }
+  }
+}
+
+bool ContainsIndex::contains(const Eigen::Vector2d& p) const {
+  const IntPoint q = to_int(p);
+  if (bands_.empty() || q.Y < y0_ || (q.Y - y0_) / band_ >= cInt(bands_.size())) return false;
+  const std::vector<Edge>& edges = bands_[size_t((q.Y - y0_) / band_)];
+  int winding = 0;
+  // ClipperLib::PointInPolygon's loop over one path's edges (in the band), with its -1 (on the
+  // boundary) folded into "inside", as contains() takes any non-zero answer.
+  for (size_t i = 0; i < edges.size();) {
+    const int path = edges[i].path;
+    bool inside = false, on_boundary = false;
+    for (; i < edges.size() && edges[i].path == path; ++i) {
+      if (on_boundary) continue;
+      const IntPoint &ip = edges[i].a, &next = edges[i].b;
+      if (next.Y == q.Y && (next.X == q.X || (ip.Y == q.Y && ((next.X > q.X) == (ip.X < q.X))))) {
+        on_boundary = true;
+        continue;
+      }
+      if ((ip.Y < q.Y) == (next.Y < q.Y)) continue;
+      if (ip.X >= q.X && next.X > q.X) {
+        inside = !inside;
+      } else if (ip.X >= q.X || next.X > q.X) {
+        const double d = double(ip.X - q.X) * double(next.Y - q.Y) - double(next.X - q.X) * double(ip.Y - q.Y);
+        if (d == 0)
+          on_boundary = true;
+        else if ((d > 0) == (next.Y > ip.Y))
+          inside = !inside;
+      }
+    }
+    if (inside || on_boundary) winding += path_sign_[size_t(path)];
+  }
   return winding > 0;
 }
 

@@ -33,6 +33,25 @@ std::vector<Polyline2d> clip_lines_outside(const std::vector<Polyline2d>& lines,
 bool contains(const Paths& region, const Eigen::Vector2d& p);
 double area(const Paths& region);
 
+// contains() for a region asked many times (the ground under each walking actor at every keyframe of
+// every scan): the same answer, bit for bit, from only the edges that reach the point's horizontal
+// band instead of every edge of the region. The point-in-polygon test is Clipper's (Hormann and
+// Agathos 2001), which an edge whose y-range misses the point's y never affects.
+class ContainsIndex {
+ public:
+  explicit ContainsIndex(const Paths& region, double band_m = 1.0);
+  bool contains(const Eigen::Vector2d& p) const;
+
+ private:
+  struct Edge {
+    ClipperLib::IntPoint a, b;
+    int path;
+  };
+  std::vector<int> path_sign_;  // +1 for an outer path, -1 for a hole (Clipper's orientation)
+  ClipperLib::cInt y0_ = 0, band_ = 1;
+  std::vector<std::vector<Edge>> bands_;  // each band's edges, grouped by path
+};
+
 // Triangulates a region as a surface whose height is given per vertex, by a quadtree on a global grid
 // (so neighbouring regions share tile edges): squares wholly inside the region become two triangles
 // each at most `max_square` wide (so a curved surface is sampled that densely); squares the region's

@@ -536,9 +536,9 @@ struct Builder {
 }  // namespace
 
 GroundHeight World::ground() const {
-  auto area = std::make_shared<const region::Paths>(carriageway);
+  auto area = std::make_shared<const region::ContainsIndex>(carriageway);
   return [area, surface = surface, raised = raised_level](const Eigen::Vector2d& p) {
-    return region::contains(*area, p) ? surface->carriageway(p) : double(raised(p));
+    return area->contains(p) ? surface->carriageway(p) : double(raised(p));
   };
 }
 

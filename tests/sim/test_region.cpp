@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -194,6 +195,45 @@ TEST(RegionStrip, ClosedCentrelineIsARing) {
   EXPECT_NEAR(region::area(ring), outer - inner, 1e-3 * (outer - inner));
   EXPECT_FALSE(region::contains(ring, {kSide / 2, kSide / 2}));  // the hole
   EXPECT_TRUE(region::contains(ring, {kSide / 2, 0}));
+}
+
+TEST(RegionContainsIndex, AnswersAsContainsEverywhereIncludingOnTheBoundary) {
+  // A ring with a hole, and a closed L beside it: known inside and outside points, then contains()'s
+  // own answer at random points, at every vertex and at every edge's midpoint (on the boundary).
+  constexpr double kSide = 100.0, kHalfWidth = 5.0;
+  region::Paths world = region::strip({{0, 0}, {kSide, 0}, {kSide, kSide}, {0, kSide}, {0, 0}}, kHalfWidth, true);
+  const region::Paths l_shape =
+      region::closing(region::unite(region::strip({{150, 0}, {250, 0}}, kHalfWidth, false),
+                                    region::strip({{155, -5}, {155, 100}}, kHalfWidth, false)),
+                      8.0);
+  world.insert(world.end(), l_shape.begin(), l_shape.end());
+  const region::ContainsIndex index(world, 0.7);
+  EXPECT_FALSE(index.contains({kSide / 2, kSide / 2}));  // the hole
+  EXPECT_TRUE(index.contains({kSide / 2, 0}));
+  EXPECT_TRUE(index.contains({200, 0}));
+  EXPECT_FALSE(index.contains({200, 50}));
+  EXPECT_FALSE(index.contains({50, -1000}));  // beyond the bands
+  EXPECT_FALSE(index.contains({50, 1000}));
+
+  std::vector<Eigen::Vector2d> probes;
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> x(-20, 270), y(-20, 120);
+  for (int i = 0; i < 20000; ++i) probes.emplace_back(x(rng), y(rng));
+  for (const auto& path : world)
+    for (size_t i = 0; i < path.size(); ++i) {
+      const auto& a = path[i];
+      const auto& b = path[(i + 1) % path.size()];
+      probes.emplace_back(double(a.X) / region::kScale, double(a.Y) / region::kScale);
+      if ((a.X + b.X) % 2 == 0 && (a.Y + b.Y) % 2 == 0)
+        probes.emplace_back(double((a.X + b.X) / 2) / region::kScale, double((a.Y + b.Y) / 2) / region::kScale);
+    }
+  int inside = 0;
+  for (const auto& p : probes) {
+    ASSERT_EQ(index.contains(p), region::contains(world, p)) << p.transpose();
+    inside += index.contains(p);
+  }
+  EXPECT_GT(inside, 1000);  // the probes did reach both answers
+  EXPECT_LT(inside, int(probes.size()) - 1000);
 }
 
 TEST(RegionClosing, FilletAtInnerCornerOfLShape) {
