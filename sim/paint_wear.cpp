@@ -31,9 +31,10 @@ PaintConfig paint_config_for(Realism realism) {
   PaintConfig c;
   switch (realism) {
     case Realism::ideal:
-    case Realism::typical:  // uniform paint: see PaintConfig::varied
-      c.varied = false;
+      c.varied = false;  // uniform, new paint
       break;
+    case Realism::typical:
+      break;  // the sourced campus figures: PaintConfig's defaults
     case Realism::harsh:
       // Markings near the end of their life: R_L about the maintained minimums (FHWA 50-100, middle 75,
       // spread so that 50 is 1 sigma below and 100 one above: assumption), floored at the lower

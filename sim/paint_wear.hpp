@@ -3,11 +3,10 @@
 // have, worn patches where the paint is gone to the asphalt, the LiDAR reflectivity that follows the
 // retroreflectivity loosely, and markings faded further or re-painted between the survey and the drive.
 //
-// `ideal` and `typical`: uniform paint, every marking its material's reflectivity, as before this knob
-// (see PaintConfig::varied for why typical keeps it); `paint: {varied: true}`: worn paint with the
-// sourced campus figures below (the defaults of the other keys); `harsh`: worn paint near the end of its
-// life (paint_config_for).
-//   varied             bool      false  true: worn paint as below; false: uniform (nothing below applies)
+// `typical`: worn paint with the sourced campus figures below (the defaults); `ideal`: uniform paint,
+// every marking its material's reflectivity (`paint: {varied: false}` in any profile); `harsh`: worn
+// paint near the end of its life (paint_config_for).
+//   varied             bool      true   true: worn paint as below; false: uniform (nothing below applies)
 //   retro_mean_mcd     mcd/m2/lx 162.5  mean retroreflectivity of a marking
 //   retro_sigma_mcd    mcd/m2/lx 43.75  its spread between markings (1 sigma)
 //   retro_min_mcd      mcd/m2/lx 75     floor: a marking below it would have been re-painted
@@ -42,11 +41,9 @@
 namespace lidarloop {
 
 struct PaintConfig {
-  // `typical` keeps uniform paint: with worn paint (varied: true and the figures below) the shipped
-  // scenario cold_start_parked, where parked rows hide the curbs and only the lane paint places the car,
-  // failed its heading threshold (0.43 deg RMSE against 0.40; 0.26 with uniform paint), and the
-  // thresholds are not to be loosened for a model change. Worn paint is one key away: varied: true.
-  bool varied = false;
+  // Worn paint with the campus figures below: `typical`'s. `ideal` sets it false: every marking its
+  // material's reflectivity (uniform, new paint).
+  bool varied = true;
   // Retroreflectivity R_L of dry white markings, mcd/m2/lx. New markings: at least 250 (ASTM D6359,
   // the common specification for new white markings); maintained minimum: 50-100 (FHWA's minimum
   // retroreflectivity rule, MUTCD 2009 Rev. 3 section 3A.03, 2022: 50 at 35 mph and above, 100 at 70

@@ -201,11 +201,14 @@ TEST(PaintWear, AWorldLosesTheWornShareOfItsPaintArea) {
 
 TEST(PaintWear, UniformPaintBuildsTheWorldAsBefore) {
   const World before = build(std::nullopt);
-  for (Realism r : {Realism::ideal, Realism::typical}) {
-    const World uniform = build(PaintConditions{paint_config_for(r), PaintDay::drive});
-    EXPECT_TRUE(same_mesh(before, uniform)) << realism_name(r);
-    EXPECT_TRUE(uniform.paint_materials.empty()) << realism_name(r);
+  PaintConfig off;
+  off.varied = false;
+  for (const PaintConfig& c : {paint_config_for(Realism::ideal), off}) {
+    const World uniform = build(PaintConditions{c, PaintDay::drive});
+    EXPECT_TRUE(same_mesh(before, uniform));
+    EXPECT_TRUE(uniform.paint_materials.empty());
   }
+  EXPECT_FALSE(same_mesh(before, build(PaintConditions{paint_config_for(Realism::typical), PaintDay::drive})));
 }
 
 TEST(PaintWear, TheSameSeedBuildsTheSameWorldByteForByte) {
@@ -264,7 +267,7 @@ TEST(PaintWear, ImportedWorldsWearTheirPaintToo) {
     WorldDescription d =
         osm ? lanelet2_world_description(test::data_path(file)) : opendrive_world_description(test::data_path(file));
     const World before = build_world(d, test::materials(), test::data_path("assets/actors"));
-    d.paint = PaintConditions{paint_config_for(Realism::typical), PaintDay::drive};
+    d.paint = PaintConditions{paint_config_for(Realism::ideal), PaintDay::drive};
     EXPECT_TRUE(same_mesh(before, build_world(d, test::materials(), test::data_path("assets/actors")))) << file;
     d.paint = PaintConditions{worn(), PaintDay::drive};
     const World after = build_world(d, test::materials(), test::data_path("assets/actors"));
@@ -278,12 +281,13 @@ TEST(PaintWear, ImportedWorldsWearTheirPaintToo) {
 
 TEST(PaintWear, TheProfilesAndTheScenarioKeys) {
   EXPECT_FALSE(paint_config_for(Realism::ideal).varied);
-  EXPECT_FALSE(paint_config_for(Realism::typical).varied);  // see PaintConfig::varied
+  EXPECT_TRUE(paint_config_for(Realism::typical).varied);
+  EXPECT_EQ(paint_config_for(Realism::typical).retro_mean_mcd, 162.5);  // the campus figures
   EXPECT_TRUE(paint_config_for(Realism::harsh).varied);
   EXPECT_LT(paint_config_for(Realism::harsh).retro_mean_mcd, PaintConfig{}.retro_mean_mcd);
   // Uniform paint adds nothing to a map's cache key: the maps made before this knob keep theirs.
   EXPECT_EQ(paint_config_for(Realism::ideal).describe_survey(), "");
-  EXPECT_EQ(paint_config_for(Realism::typical).describe_survey(), "");
+  EXPECT_NE(paint_config_for(Realism::typical).describe_survey(), "");
   // The drive day's changes do not change what the survey saw (the map's cache key).
   PaintConfig changed = worn();
   changed.faded_fraction = 0.4;
@@ -297,6 +301,7 @@ TEST(PaintWear, TheProfilesAndTheScenarioKeys) {
   EXPECT_EQ(s.paint.worn_fraction, 0.25);
   EXPECT_EQ(s.paint.seed, 9u);
   EXPECT_FALSE(parse_scenario(base + "realism: ideal\n", "ideal.yaml").paint.varied);
+  EXPECT_FALSE(parse_scenario(base + "paint: {varied: false}\n", "uniform.yaml").paint.varied);
   try {
     parse_scenario(base + "paint: {worn_fractoin: 0.25}\n", "typo.yaml");
     FAIL() << "an unknown key was accepted";
