@@ -125,6 +125,13 @@ struct Builder {
           out.push_back({s - other.width / 2 - c.crosswalk_clearance_m, s + other.width / 2 + c.crosswalk_clearance_m});
       }
     }
+    // On a closed road a span's clearance reaching past either end of the centreline continues from
+    // the other end.
+    if (r.road->closed)
+      for (size_t i = 0, n = out.size(); i < n; ++i) {
+        if (out[i].first < 0) out.push_back({out[i].first + r.length, out[i].second + r.length});
+        if (out[i].second > r.length) out.push_back({out[i].first - r.length, out[i].second - r.length});
+      }
     return out;
   }
 

@@ -77,6 +77,37 @@ parking:
   std::cout << "[ figures  ] parked occupancy " << occupancy << " over " << stalls << " stalls (asked 0.85)\n";
 }
 
+TEST(StreetUse, ACrosswalksClearanceContinuesAcrossAClosedRoadsStart) {
+  // A closed road whose centreline starts mid-straight, 2 m before a crosswalk: the clearance behind
+  // the crosswalk lies at the end of the centreline, where the stretch parked at full occupancy ends.
+  const WorldDescription ring = parse_world_description(R"(
+name: ring
+origin: {lat: 31.28, lon: 121.21, alt: 0}
+roads:
+  - {name: ring, closed: true, points: [[0, 0], [200, 0], [200, 100], [-200, 100], [-200, 0]], width: 9.0}
+crosswalks:
+  - {road: ring, near: [2, 0], width: 4}
+)",
+                                                        "ring.yaml");
+  StreetUse street = read(R"(
+parking:
+  occupancy: 1.0
+  truck_share: 0
+  stretches: [{road: ring, side: right, from: 939.7, to: 1000}]   # nine stalls, the last ending at the start
+)");
+  const auto actors = street_actors(street, ring, 60, 7, 0);
+  ASSERT_FALSE(actors.empty());
+  const double clear = 4.0 / 2 + street.parking.crosswalk_clearance_m;
+  double nearest = 1e9;
+  for (const auto& a : actors) {
+    const Pose2d p = a.plan.path.pose_at(0);
+    ASSERT_NEAR(p.y, -kWidth / 2 + street.parking.curb_gap_m + actor_footprint(ActorType::car).width / 2, 1e-6);
+    nearest = std::min(nearest, std::abs(p.x - 2.0) - street.parking.stall_length_m / 2);
+  }
+  EXPECT_GE(nearest, clear - 1e-6) << "a stall reaches into the crosswalk's clearance across the road's start";
+  EXPECT_LT(nearest, clear + street.parking.stall_length_m);  // the next stall out is taken
+}
+
 TEST(StreetUse, NobodyParksAcrossTheMouthOfASideStreet) {
   // A side street meets `main` from the north (its left) at x = 600.
   const WorldDescription d = parse_world_description(R"(
