@@ -26,6 +26,10 @@ MappingOptions scenario_mapping_options(const Scenario& scenario) {
     const YamlReader y = YamlReader::from_string(scenario.text, scenario.file);
     if (y.root().IsMap() && y.root()["survey"]) read_survey_options(y, y.root()["survey"], options);
   }
+  // The street was parked on the survey day too, with other cars.
+  if (options.parked_on_survey_day && !scenario.street.parking.stretches.empty())
+    options.parked =
+        survey_day_parking(scenario.street.parking, load_world_description_of(scenario.world), options.seed);
   return options;
 }
 

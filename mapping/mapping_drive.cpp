@@ -12,8 +12,10 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
+#include "common/crc32.hpp"
 #include "common/units.hpp"
 #include "sim/actor_assets.hpp"
+#include "sim/counter_rng.hpp"
 #include "sim/hdl32e.hpp"
 #include "sim/lidar_scanner.hpp"
 #include "sim/path.hpp"
@@ -65,6 +67,16 @@ std::string MappingOptions::describe() const {
   if (!curb_label.is_default()) s << " " << curb_label.describe();  // the same
   // Uniform paint adds nothing, so the maps made before worn paint keep their keys.
   if (const std::string p = paint.describe_survey(); !p.empty()) s << " " << p;
+  if (!parked.empty()) {  // the cars' places, as a checksum: hundreds of them would not fit the header
+    std::ostringstream cars;
+    for (const ActorPlan& a : parked) {
+      const Pose2d p = actor_pose2d(a, 0);
+      cars << actor_type_name(a.type) << " " << p.x << " " << p.y << " " << p.yaw << "\n";
+    }
+    Crc32 crc;
+    crc.update(cars.str().data(), cars.str().size());
+    s << " parked=" << parked.size() << "/" << std::hex << crc.value() << std::dec;
+  }
   return s.str();
 }
 
@@ -147,7 +159,8 @@ void read_survey_options(const YamlReader& yaml, const YAML::Node& node, Mapping
       .number("slam_relative_over_m", e.slam.relative_over_m, kMinLength, kMaxLength)
       .number("sample_spacing_m", e.sample_spacing_m, kMinLength, kMaxSpacing)
       .number("label_noise_m", o.curb_label.noise_m, 0.0, kMaxLabelNoise)
-      .number("label_noise_correlation_m", o.curb_label.noise_correlation_m, kMinLength, kMaxLength);
+      .number("label_noise_correlation_m", o.curb_label.noise_correlation_m, kMinLength, kMaxLength)
+      .boolean("parked_on_survey_day", o.parked_on_survey_day);
   m.done();
   if (slam) {
     try {
@@ -156,6 +169,17 @@ void read_survey_options(const YamlReader& yaml, const YAML::Node& node, Mapping
       yaml.fail(m.node(), error.what());
     }
   }
+}
+
+std::vector<ActorPlan> survey_day_parking(const ParkingConfig& parking, const WorldDescription& description,
+                                          uint64_t mapping_seed) {
+  constexpr uint64_t kSurveyDayStream = 0x7375727665796461;  // "surveyda"
+  StreetUse street;
+  street.parking = parking;
+  std::vector<ActorPlan> cars;
+  for (StreetActor& a : street_actors(street, description, 0, mix64(mapping_seed ^ kSurveyDayStream), 0))
+    cars.push_back(std::move(a.plan));
+  return cars;
 }
 
 SurveyDrive mapping_survey(const WorldDescription& description, const MappingOptions& o) {
@@ -209,6 +233,7 @@ struct DriveSetup {
   // has none. Lanes with traffic make their own.
   RayScene& scene;
   const GroundHeight& pavement;
+  const GroundHeight& ground;  // where the actors stand (World::ground)
 };
 
 std::vector<ActorPlan> oncoming_traffic(const SurveyLane& lane, const MappingOptions& o) {
@@ -313,15 +338,17 @@ PartMaps drive_part(const DriveSetup& d, const IntensityMapHeader& header, const
   const int64_t period = d.lidar.scan_period_ns();
   const Eigen::Isometry3d mount = d.lidar.mount();
 
-  // Oncoming traffic on the other side of this road, if asked: a scene of this lane's own.
-  const std::vector<ActorPlan> traffic = oncoming_traffic(lane, o);
+  // Oncoming traffic on the other side of this road, if asked: a scene of this lane's own, with the
+  // survey day's parked cars too (the shared scene has them).
+  std::vector<ActorPlan> traffic = oncoming_traffic(lane, o);
   std::unique_ptr<RayScene> own_scene;
   if (!traffic.empty()) {
     own_scene = std::make_unique<RayScene>(d.world.mesh, 0, RayScene::MeshBuffers::shared);
-    add_actors(*own_scene, traffic, d.actors_dir, d.materials);
+    traffic.insert(traffic.end(), o.parked.begin(), o.parked.end());
+    add_actors(*own_scene, traffic, d.actors_dir, d.materials, d.ground);
   }
   RayScene& scene = own_scene ? *own_scene : d.scene;
-  const ActorPoses actor_poses = actor_motion(traffic);
+  const ActorPoses actor_poses = actor_motion(traffic, d.ground);
 
   // The car is where the truth says, resting on the crowned, rough road; its scans are placed where
   // the survey says: the survey's plan position and heading error moves the whole body.
@@ -418,7 +445,10 @@ IntensityMapBuilder drive(const WorldDescription& description, const World& worl
   const SurveyDrive survey = mapping_survey(description, o);
   // The world's mesh outlives the drive: Embree reads it where it is rather than from a copy.
   RayScene scene(world.mesh, 0, RayScene::MeshBuffers::shared);
-  const DriveSetup setup{world, materials, actors_dir, o, survey, lidar, scanner, scene, pavement};
+  const GroundHeight ground = world.ground();
+  // The parked cars never move, so the parts can share the scene they stand in (scan() moves nothing).
+  if (!o.parked.empty()) add_actors(scene, o.parked, actors_dir, materials, ground);
+  const DriveSetup setup{world, materials, actors_dir, o, survey, lidar, scanner, scene, pavement, ground};
   const std::vector<DrivePart> parts = plan_parts(header, survey, o, lidar);
 
   // Which part is the last to reach each tile: once it is merged, the tile is finished.

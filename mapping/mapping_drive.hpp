@@ -17,6 +17,8 @@
 #include "mapping/survey_map.hpp"
 #include "sim/materials.hpp"
 #include "sim/realism.hpp"
+#include "sim/street_use.hpp"
+#include "sim/traffic.hpp"
 #include "sim/world_assets.hpp"
 #include "sim/world_builder.hpp"
 
@@ -44,6 +46,13 @@ struct MappingOptions {
   // The markings' wear on the survey day (sim/paint_wear.hpp): a scenario's `paint`, as it was before
   // the changes the drive day shows.
   PaintConfig paint;
+  // Vehicles parked along the streets on the survey day (survey_day_parking), which the survey saw
+  // as it sees the world: they hide the road under and behind them from the intensity layer, and stand
+  // in the point layer. Empty: nobody parked.
+  std::vector<ActorPlan> parked;
+  // Whether a scenario's street parking (`street.parking`) was also there, with other cars, on the
+  // survey day (read_survey_options' `parked_on_survey_day`; used by survey_day_parking's callers).
+  bool parked_on_survey_day = true;
   // The point-cloud layer's voxel, m: one point (the centroid) per voxel. 0.4 m keeps the surfaces a
   // GICP needs (curb faces, walls, poles of 0.1-0.3 m are one voxel thick) at about a quarter of the
   // points of 0.2 m, and divides the intensity tiles' 64 m into whole voxels (160), so both layers
@@ -71,8 +80,14 @@ LoadedWorld load_mapped_world(const std::string& world, const MappingOptions& op
 // other keys then override that provenance's figures), sigma_xy_m, correlation_length_m,
 // heading_sigma_deg, heading_correlation_length_m (rtk_ins), slam_absolute_m, slam_relative_m,
 // slam_relative_over_m (slam), sample_spacing_m, curb_label (face_foot, face_top or gutter_line),
-// label_noise_m, label_noise_correlation_m.
+// label_noise_m, label_noise_correlation_m, parked_on_survey_day.
 void read_survey_options(const YamlReader& yaml, const YAML::Node& node, MappingOptions& options);
+
+// The street parking of `parking` as it was on the survey day: the same stretches and occupancy, the
+// cars drawn for another day (from `mapping_seed`, not the scenario's seed, so one map serves every
+// seed of a scenario and the drive day's cars are not the survey day's).
+std::vector<ActorPlan> survey_day_parking(const ParkingConfig& parking, const WorldDescription& description,
+                                          uint64_t mapping_seed);
 
 // The survey the mapping drive with these options makes: its lanes and its error, drawn from an engine
 // seeded with options.seed (the same every time for the same options).

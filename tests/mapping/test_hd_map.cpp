@@ -10,6 +10,7 @@
 #include "localizer/curb_layer.hpp"
 #include "localizer/hd_map.hpp"
 #include "mapping/mapping_drive.hpp"
+#include "sim/actor_assets.hpp"
 #include "test_support.hpp"
 
 namespace lidarloop {
@@ -130,6 +131,58 @@ TEST(IntensityLayer, TrafficRaisesTheVarianceOfTheCellsItCrosses) {
   ASSERT_GT(n_busy, 1000);
   EXPECT_GT(busy, 1.3 * clean) << "variance with traffic " << busy << ", without " << clean;
   std::cout << "[ figures  ] oncoming-lane cell variance with traffic " << busy << ", without " << clean << "\n";
+}
+
+// The survey day's parked cars: the road under a parked car is hidden from the survey (no ground
+// cells there), the road beside it is not; the cars are drawn for another day than the drive's, at the
+// same occupancy, and they change the map's options (its cache key).
+TEST(IntensityLayer, TheSurveyDaysParkedCarsHideTheRoadUnderThemFromTheMap) {
+  const WorldDescription d = parse_world_description(kStraight, "survey.yaml");
+  const World w = build_world(d, test::materials(), test::data_path("assets/actors"));
+  ParkingConfig parking;
+  parking.stretches.push_back({"survey.yaml:1", "main", RoadSide::right, 20, 80});
+  parking.occupancy = 1.0;
+  parking.truck_share = 0;
+  MappingOptions o;
+  o.parked = survey_day_parking(parking, d, o.seed);
+  ASSERT_EQ(o.parked.size(), size_t(60 / parking.stall_length_m));  // every stall, at full occupancy
+  EXPECT_NE(o.describe(), MappingOptions{}.describe());
+  const IntensityMapBuilder map =
+      run_mapping_drive(d, w, test::materials(), test::data_path("assets/actors"), o, "parked");
+  const ActorFootprint car = actor_footprint(ActorType::car);
+  // Returns from the road in the footprints' middles (0.5 m in from the ends and sides), with the cars
+  // and on the empty street. Rays still reach under a car between its wheels, at a grazing angle.
+  double hits_under = 0, hits_empty = 0;
+  for (const ActorPlan& a : o.parked) {
+    const Pose2d p = actor_pose2d(a, 0);
+    for (double dx = -car.length / 2 + 0.5; dx <= car.length / 2 - 0.5; dx += 0.2)
+      for (double dy = -car.width / 2 + 0.5; dy <= car.width / 2 - 0.5; dy += 0.2) {
+        const Eigen::Vector2d c(p.x + dx, p.y + dy);
+        hits_under += map.cell(c).value_or(IntensityCell{}).count;
+        hits_empty += Survey::map(false).cell(c).value_or(IntensityCell{}).count;
+      }
+  }
+  ASSERT_GT(hits_empty, 10000);
+  EXPECT_LT(hits_under, 0.2 * hits_empty)
+      << hits_under << " returns under the parked cars, " << hits_empty << " on the empty street";
+  // The drive day's cars for the same stretch (a scenario's seed) stand elsewhere: another day.
+  StreetUse street;
+  street.parking = parking;
+  street.parking.occupancy = 0.5;
+  parking.occupancy = 0.5;
+  const auto drive_day = street_actors(street, d, 0, o.seed, 0);
+  const auto survey_day = survey_day_parking(parking, d, o.seed);
+  size_t same = 0;
+  for (const StreetActor& a : drive_day)
+    for (const ActorPlan& b : survey_day) same += (actor_pose2d(a.plan, 0).x == actor_pose2d(b, 0).x);
+  EXPECT_LT(same, drive_day.size()) << "the survey day parked exactly as the drive day";
+  // A scenario may survey an empty street.
+  const YamlReader yaml = YamlReader::from_string("survey: {parked_on_survey_day: false}\n", "survey.yaml");
+  MappingOptions empty_street;
+  read_survey_options(yaml, yaml.root()["survey"], empty_street);
+  EXPECT_FALSE(empty_street.parked_on_survey_day);
+  std::cout << "[ figures  ] road returns under the survey day's parked cars: " << hits_under << " against "
+            << hits_empty << " on the empty street\n";
 }
 
 }  // namespace

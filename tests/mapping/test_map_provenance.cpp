@@ -128,8 +128,11 @@ TEST(SlamMapError, BothPassesOfAStreetShareItsErrorWhereTheRtkSurveysDoNot) {
 }
 
 TEST(MapProvenance, TheDefaultSurveyKeepsItsCacheKey) {
-  // The text every cached typical map was keyed by before there were provenances and conventions.
-  EXPECT_EQ(MappingOptions{}.describe(),
+  // The text every cached typical map was keyed by before there were provenances and conventions (and
+  // before typical's paint was worn: uniform paint adds nothing to it).
+  MappingOptions uniform;
+  uniform.paint.varied = false;
+  EXPECT_EQ(uniform.describe(),
             "traffic=0 speed=15 resolution=0.2 tile_cells=320 max_ground_height=0.5 max_range=40 seed=1 "
             "survey_unit_serial=2 sigma_xy_m=0.02 correlation_length_m=100 heading_sigma_deg=0.05 "
             "heading_correlation_length_m=100 sample_spacing_m=0.5 point_voxel=0.4 point_scan_stride=4");

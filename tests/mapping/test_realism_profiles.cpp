@@ -29,9 +29,9 @@ TEST(RealismProfiles, EachProfileSurveysItsOwnMap) {
 
 // The survey's paint is in the map's cache key; the drive day's changes to it are not (the map is the same).
 TEST(RealismProfiles, TheSurveysPaintIsInTheMapsCacheKey) {
-  MappingOptions worn;
-  worn.paint.varied = true;
-  EXPECT_NE(worn.describe(), MappingOptions{}.describe());
+  MappingOptions worn, uniform;
+  uniform.paint.varied = false;
+  EXPECT_NE(worn.describe(), uniform.describe());
   MappingOptions faded = worn;
   faded.paint.faded_fraction = 0.5;
   faded.paint.repainted_fraction = 0.3;
@@ -40,7 +40,8 @@ TEST(RealismProfiles, TheSurveysPaintIsInTheMapsCacheKey) {
   more_worn.paint.worn_fraction = 0.3;
   EXPECT_NE(more_worn.describe(), worn.describe());
   EXPECT_TRUE(mapping_options_for(Realism::harsh).paint.varied);
-  EXPECT_FALSE(mapping_options_for(Realism::typical).paint.varied);
+  EXPECT_TRUE(mapping_options_for(Realism::typical).paint.varied);
+  EXPECT_FALSE(mapping_options_for(Realism::ideal).paint.varied);
 }
 
 TEST(RealismProfiles, TheIdealMapsWorldIsOnIdealGround) {
