@@ -38,8 +38,9 @@ constexpr uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3
 // azimuth on the 0.01 deg grid, 2 mm ranges, the calibration's elevations). 7: Embree's kernels fixed
 // to SSE4.2 (sim/ray_scene.cpp), so a map built on one machine is the map built on any other. 8: a
 // Lanelet2 world's lanes are surveyed along the line a car drives (sim/lane_graph.hpp's
-// route_driven_line), not their kinked centrelines.
-constexpr int kMapFormatVersion = 8;
+// route_driven_line), not their kinked centrelines. 9: the survey's oncoming traffic (`traffic`) stands
+// on the ground, where it stood at height 0.
+constexpr int kMapFormatVersion = 9;
 
 static void hash_bytes(uint64_t& h, const std::string& bytes) {
   for (unsigned char c : bytes) h = (h ^ c) * kFnvPrime;
