@@ -142,6 +142,7 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
       actor_poses(stamp_ns + k * keyframe_step_ns_, poses);
       for (size_t a = 0; a < poses.size(); ++a) motion[a].push_back(poses[a]);
     }
+    if (weather_.spray && weather_.wet) spray = spray_boxes(motion);  // every keyframe of every actor
     // An actor standing still is one pose, not a motion: Embree then traverses it as a static
     // instance, not through a motion-blur BVH (a parked street's hundreds of cars).
     for (auto& m : motion)
@@ -149,7 +150,6 @@ PointCloud LidarScanner::scan(RayScene& scene, const PoseAt& vehicle_pose, int64
         m.resize(1);
     for (size_t a = 0; a < motion.size(); ++a) scene.set_actor_motion(int(a), motion[a]);
     scene.commit();
-    if (weather_.spray && weather_.wet) spray = spray_boxes(motion);
   }
   const size_t spray_per_keyframe = spray.size() / size_t(keyframes_ - 1 > 0 ? keyframes_ - 1 : 1);
 

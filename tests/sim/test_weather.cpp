@@ -145,6 +145,38 @@ TEST(Weather, SprayTrailsAMovingCarOnAWetRoad) {
   EXPECT_EQ(behind_car(wet), 0);
 }
 
+TEST(Weather, AParkedCarThrowsNoSprayBesideAMovingOne) {
+  // The moving car of the test above and a parked one 5 m to its left: the scanner gives a parked
+  // actor to Embree as one pose, and its spray (none) still comes from all its keyframes.
+  TriangleMesh world = test::flat_ground(80);
+  TriangleMesh car;
+  add_box(car, {0, 0}, {2.2f, 0.9f}, 0, 0.3f, 1.5f, test::materials().id("vehicle_paint", "test"));
+  RayScene scene(world);
+  const int prototype = scene.add_prototype(car);
+  scene.add_actor(prototype, Eigen::Isometry3d::Identity());
+  scene.add_actor(prototype, Eigen::Isometry3d::Identity());
+  scene.commit();
+  const Hdl32eConfig config = test::noiseless_hdl32e();
+  const ActorPoses poses = [](int64_t t, std::vector<Eigen::Isometry3d>& p) {
+    p[0] = Eigen::Isometry3d(Eigen::Translation3d(10 + 15.0 * double(t) * 1e-9, 0, 0));
+    p[1] = Eigen::Isometry3d(Eigen::Translation3d(10, 5, 0));
+  };
+  WeatherConfig wet;
+  wet.wet = true;
+  wet.spray = true;
+  const LidarScanner scanner(config, test::materials(), wet);
+  int behind_moving = 0, behind_parked = 0;
+  for (const auto& p :
+       scanner.scan(scene, constant_twist(Eigen::Isometry3d::Identity(), 0, 0, 0), 0, kSeed, poses).points) {
+    const Eigen::Vector3d g = world_point(p, config);
+    if (g.z() <= 0.2 || g.x() <= 2 || g.x() >= 7.5) continue;  // above the road, behind the cars
+    behind_moving += std::abs(g.y()) < 1;
+    behind_parked += std::abs(g.y() - 5) < 1;
+  }
+  EXPECT_GT(behind_moving, 20);
+  EXPECT_EQ(behind_parked, 0);
+}
+
 TEST(Weather, ProfilesAndScenarioKeys) {
   EXPECT_TRUE(weather_config_for(Realism::ideal).dry());
   EXPECT_TRUE(weather_config_for(Realism::typical).dry());
