@@ -26,7 +26,11 @@ enum class CurbLabel { face_foot, face_top, gutter_line };
 const char* curb_label_name(CurbLabel label);
 
 struct CurbLabelConfig {
-  // The world's own line, so the default map's curbs are the ones it always had.
+  // Assumption (no mapping team's convention is published): a mobile-mapping survey extracts its curb
+  // layer from its own scans with an automatic detector of the kind the localizer runs (the paper does
+  // not say how its curb layer was made), and such a detector finds the foot of the rise.
+  // Of the three lines it is also the middle one, between the gutter's lip in front and the face's top
+  // behind. A map labelled by hand on a point cloud (harsh) takes the top instead.
   CurbLabel convention = CurbLabel::face_foot;
   // RMS of the drawn line's offset across the curb, m, correlated along it. Assumption, no published
   // figure found for curb polylines: 0 by default (the map's line is the convention's line exactly);
