@@ -9,9 +9,10 @@
 namespace lidarloop {
 
 KidnapSchedule::KidnapSchedule(const Scenario& scenario)
-    : kidnaps_(scenario.kidnaps),
-      lidar_offset_ns_(scenario.clocks.lidar.offset_ns),
-      scan_period_ns_(scenario.lidar.scan_period_ns()) {
+    : lidar_offset_ns_(scenario.clocks.lidar.offset_ns), scan_period_ns_(scenario.lidar.scan_period_ns()) {
+  // A kidnap that moves the car is the simulation's (sim/simulation.hpp): the scans show it.
+  for (const KidnapFault& k : scenario.kidnaps)
+    if (k.moves == KidnapMoves::belief) kidnaps_.push_back(k);
   // Stable: two kidnaps at the same time are done in the scenario's order.
   std::stable_sort(kidnaps_.begin(), kidnaps_.end(),
                    [](const KidnapFault& a, const KidnapFault& b) { return a.at_s < b.at_s; });
@@ -29,10 +30,13 @@ std::vector<Pose2d> KidnapSchedule::due(int64_t scan_stamp_ns) {
 }
 
 void check_kidnaps_supported(const Scenario& scenario, const LocalizerParams& params) {
-  if (!scenario.kidnaps.empty() && !params.external.command.empty())
-    throw InputError(scenario.file + ": faults: kidnap needs a built-in localizer method (" + method_label(params) +
-                     " is an external program, whose belief lidarloop cannot move; moving its GPS instead would "
-                     "be a GPS jump, not a kidnap: see docs/external-localizer.md)");
+  const bool moves_a_belief = std::any_of(scenario.kidnaps.begin(), scenario.kidnaps.end(),
+                                          [](const KidnapFault& k) { return k.moves == KidnapMoves::belief; });
+  if (moves_a_belief && !params.external.command.empty())
+    throw InputError(scenario.file + ": faults: a kidnap that moves the belief needs a built-in localizer method (" +
+                     method_label(params) +
+                     " is an external program, whose belief lidarloop cannot move; `moves: car` kidnaps the car "
+                     "instead, which every method meets: see docs/external-localizer.md)");
 }
 
 }  // namespace lidarloop

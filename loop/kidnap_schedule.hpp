@@ -1,5 +1,5 @@
 #pragma once
-// The scenario's kidnaps (`faults:`, sim/scenario.hpp's KidnapFault) as the localizer meets them:
+// The scenario's kidnaps of the belief (`faults:`, sim/scenario.hpp's KidnapFault) as the localizer meets them:
 // each moves its pose (Localizer::displace) just before the scan that starts nearest the kidnap's
 // time, read from the scan's own stamp. That stamp is what the live loop, `replay` (from the log) and
 // the benchmark all have, so all three kidnap before the same scan and a replay stays bit-exact.
@@ -34,11 +34,11 @@ class KidnapSchedule {
 };
 
 // An external program's pose cannot be moved from outside (its protocol has no such message), so a
-// scenario with kidnaps needs a built-in method: InputError naming the scenario otherwise. Nor can a
-// kidnap be faked by moving the program's world-frame inputs (the GPS) by the offset and its answers
-// back: its map and its LiDAR would still agree with its belief, so it would see the GPS jump away from
-// both, a GPS jump and not a kidnap, in which the map and every sensor disagree with the belief
-// (docs/external-localizer.md, "No kidnaps").
+// scenario with a kidnap that moves the belief needs a built-in method: InputError naming the scenario
+// otherwise. Nor can such a kidnap be faked by moving the program's world-frame inputs (the GPS) by the
+// offset and its answers back: its map and its LiDAR would still agree with its belief, so it would see
+// the GPS jump away from both, a GPS jump and not a kidnap. A kidnap that moves the car (`moves: car`)
+// is the simulation's and reaches every method (docs/external-localizer.md, "Kidnaps").
 void check_kidnaps_supported(const Scenario& scenario, const LocalizerParams& params);
 
 }  // namespace lidarloop

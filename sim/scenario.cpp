@@ -299,6 +299,8 @@ KidnapFault read_fault(const YamlReader& y, const YAML::Node& n, double duration
   f.at_s = y.number_in(m.required("at_s"), "at_s", 0.0, duration_s);
   f.offset_m = y.vec2(m.required("offset"), "offset");
   m.degrees("yaw_deg", f.yaw_rad, -180.0, 180.0);
+  if (const YAML::Node moves = m["moves"])
+    f.moves = read_choice(y, moves, "moves", "belief", "car") ? KidnapMoves::car : KidnapMoves::belief;
   m.done();
   return f;
 }

@@ -161,13 +161,19 @@ PassThresholds load_pass_file(const std::string& path, const PassThresholds& bas
 PassThresholds parse_pass_assignment(const std::string& assignment, const std::string& what,
                                      const PassThresholds& base);
 
-// A fault done to the localizer rather than to the world (`faults:`): at at_s its pose estimate is
-// moved by `offset` (m, forward and left in its own vehicle frame) and turned by yaw, its covariance
-// left as it was, so it does not know (a kidnapped robot).
+// A kidnapped robot (`faults:`): at at_s the localizer's belief and the car part by `offset` (m,
+// forward and left in the vehicle frame) and a turn by yaw, and nothing tells the localizer.
+//   belief  its pose estimate is moved, its covariance left as it was; the car and the world go on as
+//           before. Only a built-in localizer's belief can be moved (loop/kidnap_schedule.hpp).
+//   car     the car itself is lifted and set down there between two scans, its speed, steering and
+//           suspension as they were; its wheels do not turn on the way, so the CAN does not see it.
+//           Every method meets it, an outside program too; the car steers back to its route after.
+enum class KidnapMoves { belief, car };
 struct KidnapFault {
   double at_s = 0;
   Eigen::Vector2d offset_m{0, 0};
   double yaw_rad = 0;
+  KidnapMoves moves = KidnapMoves::belief;
 };
 
 struct Scenario {

@@ -59,6 +59,10 @@ Simulation::Simulation(const Scenario& scenario, const WorldDescription& descrip
   trajectory_.push_back(vehicle_.rear_axle_pose());
   body_trajectory_.push_back(body_.attitude());
   ground_trajectory_.push_back(contact_of(vehicle_.rear_axle_pose(), pavement_, scenario.ego.vehicle));
+  for (const KidnapFault& k : scenario.kidnaps)
+    if (k.moves == KidnapMoves::car) car_kidnaps_.push_back(k);
+  std::stable_sort(car_kidnaps_.begin(), car_kidnaps_.end(),
+                   [](const KidnapFault& a, const KidnapFault& b) { return a.at_s < b.at_s; });
 }
 
 Simulation::~Simulation() = default;
@@ -82,6 +86,7 @@ void Simulation::advance_to(int64_t t_ns, StreamSink& sink) {
 
 void Simulation::step(StreamSink& sink) {
   const VehicleParams& vp = scenario_.ego.vehicle;
+  if (now_ == trajectory_start_ns_) kidnap_the_car();
   if (now_ % control_period_ns_ == 0) {
     const Pose2d truth = vehicle_.rear_axle_pose();
     const Pose2d believed = pose_source_ ? pose_source_(now_, truth) : truth;
@@ -109,6 +114,27 @@ void Simulation::step(StreamSink& sink) {
   if (now_ % gps_.period_ns() == 0) sink.on_gps(gps_.sample(now_, pose));
   if (now_ % rtk_.period_ns() == 0) sink.on_rtk(rtk_.sample(now_, pose));
   if (now_ - trajectory_start_ns_ >= scenario_.lidar.scan_period_ns()) emit_scan(sink);
+}
+
+// Between two scans, so that no scan is cast from both places: at the scan start nearest each kidnap's
+// time (from half a scan period before it), as the belief's kidnaps are done (loop/kidnap_schedule.hpp).
+// The scan being recorded starts from the new place; the body keeps its attitude on the new ground.
+void Simulation::kidnap_the_car() {
+  const int64_t half_scan = scenario_.lidar.scan_period_ns() / 2;
+  bool moved = false;
+  for (; next_car_kidnap_ < car_kidnaps_.size(); ++next_car_kidnap_) {
+    const KidnapFault& k = car_kidnaps_[next_car_kidnap_];
+    if (std::llround(k.at_s * double(kNsPerS)) - half_scan > now_) break;
+    const Pose2d from = vehicle_.rear_axle_pose();
+    const double c = std::cos(from.yaw), s = std::sin(from.yaw);
+    vehicle_.place({from.x + c * k.offset_m.x() - s * k.offset_m.y(), from.y + s * k.offset_m.x() + c * k.offset_m.y(),
+                    wrap_angle(from.yaw + k.yaw_rad)});
+    moved = true;
+  }
+  if (!moved) return;
+  const Pose2d pose = vehicle_.rear_axle_pose();
+  trajectory_.assign(1, pose);
+  ground_trajectory_.assign(1, contact_of(pose, pavement_, scenario_.ego.vehicle));
 }
 
 void Simulation::emit_scan(StreamSink& sink) {

@@ -1,7 +1,8 @@
 #pragma once
 // The simulator's main loop: the ego driven by its controller through Eq. 19, traffic on its paths,
 // and the sensors (HDL-32E, CAN, GPS, RTK truth) sampled at their own rates on an integer-nanosecond
-// clock. What it produces goes to a StreamSink, so file formats (CSV, MCAP) stay out of the loop.
+// clock; kidnaps of the car (`faults:` with `moves: car`) between two scans. What it produces goes to a StreamSink, so
+// file formats (CSV, MCAP) stay out of the loop.
 #include <functional>
 #include <memory>
 #include <string>
@@ -66,6 +67,7 @@ class Simulation {
  private:
   void step(StreamSink& sink);
   void emit_scan(StreamSink& sink);
+  void kidnap_the_car();
 
   Scenario scenario_;
   ResolvedScenario resolved_;
@@ -93,6 +95,8 @@ class Simulation {
   std::vector<BodyAttitude> body_trajectory_;     // the body on the ground plane at the same steps
   std::vector<GroundContact> ground_trajectory_;  // the wheels' contact with the pavement at the same steps
   int64_t trajectory_start_ns_ = 0;
+  std::vector<KidnapFault> car_kidnaps_;  // the scenario's kidnaps that move the car, by time
+  size_t next_car_kidnap_ = 0;
   CurbVisibilityConfig curb_visibility_;
   std::vector<Eigen::Vector3f> curb_tops_;  // the world's curbs, sampled once
 };

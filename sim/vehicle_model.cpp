@@ -232,6 +232,13 @@ void VehicleModel::step(const VehicleCommand& command) {
   state_ = next;
 }
 
+void VehicleModel::place(const Pose2d& rear_axle) {
+  const VehicleState at = state_at(params_, rear_axle, state_.vx);
+  state_.x = at.x;
+  state_.y = at.y;
+  state_.yaw = at.yaw;
+}
+
 Pose2d VehicleModel::rear_axle_pose() const {
   return {state_.x - params_.lr * std::cos(state_.yaw), state_.y - params_.lr * std::sin(state_.yaw), state_.yaw};
 }

@@ -65,6 +65,9 @@ class VehicleModel {
   static VehicleState state_at(const VehicleParams& params, const Pose2d& rear_axle, double speed);
 
   void step(const VehicleCommand& command);  // advances by params().step_ns
+  // Sets the car down with its rear axle centre at `rear_axle`, moving as it was (speed, slip, yaw
+  // rate, steering, acceleration kept): a kidnap of the car.
+  void place(const Pose2d& rear_axle);
   const VehicleState& state() const { return state_; }
   const VehicleParams& params() const { return params_; }
 

@@ -1,6 +1,6 @@
 // The scenario's kidnaps in the loop's time: each handed out once, at the scan that starts at its time
-// (read from the scan's stamp on the LiDAR's clock), in order of time; none for an external program,
-// whose pose cannot be moved.
+// (read from the scan's stamp on the LiDAR's clock), in order of time; only kidnaps of the belief, and
+// none for an external program, whose belief cannot be moved (its car can).
 #include <gtest/gtest.h>
 
 #include "common/input_error.hpp"
@@ -28,6 +28,14 @@ TEST(KidnapSchedule, HandsEachKidnapOutOnceAtTheScanThatStartsAtItsTime) {
   EXPECT_TRUE(s.due(9'000'000'000).empty());
   EXPECT_TRUE(KidnapSchedule().empty());
 
+  // A kidnap of the car is the simulation's: the scans show it, the schedule does not hand it out.
+  scenario.kidnaps = {{0.5, {1, 0}, 0, KidnapMoves::car}, {1.0, {0, 1}, 0}};
+  KidnapSchedule beliefs_only(scenario);
+  EXPECT_TRUE(beliefs_only.due(500'000'000).empty());
+  ASSERT_EQ(beliefs_only.due(1'000'000'000).size(), 1u);
+  scenario.kidnaps = {{0.5, {1, 0}, 0, KidnapMoves::car}};
+  EXPECT_TRUE(KidnapSchedule(scenario).empty());
+
   // A LiDAR clock 20 ms late (a host stamp, `harsh`): the scan that starts at 1 s is stamped 1.02 s,
   // the one before 0.92 s, which is not yet due.
   scenario.clocks.lidar.offset_ns = 20'000'000;
@@ -37,7 +45,7 @@ TEST(KidnapSchedule, HandsEachKidnapOutOnceAtTheScanThatStartsAtItsTime) {
   EXPECT_EQ(late.due(1'020'000'000).size(), 1u);
 }
 
-TEST(KidnapSchedule, AnExternalProgramCannotBeKidnapped) {
+TEST(KidnapSchedule, AnExternalProgramsBeliefCannotBeMovedButItsCarCan) {
   Scenario scenario;
   scenario.file = "kidnap.yaml";
   LocalizerParams external;
@@ -49,10 +57,13 @@ TEST(KidnapSchedule, AnExternalProgramCannotBeKidnapped) {
     check_kidnaps_supported(scenario, external);
     ADD_FAILURE() << "an external program was kidnapped";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("kidnap.yaml: faults: kidnap needs a built-in localizer method"),
+    EXPECT_NE(std::string(e.what()).find(
+                  "kidnap.yaml: faults: a kidnap that moves the belief needs a built-in localizer method"),
               std::string::npos)
         << e.what();
   }
+  scenario.kidnaps = {{8.0, {3.5, 2.0}, 0.03, KidnapMoves::car}};
+  EXPECT_NO_THROW(check_kidnaps_supported(scenario, external));
 }
 
 }  // namespace

@@ -147,15 +147,20 @@ TEST(Scenario, RealismOverridesListTheKnobSectionsScalarsInFileOrder) {
   EXPECT_EQ(realism_overrides(s), expected);  // ego, traffic, localizer and pass are not realism knobs
 }
 
-// `faults`: kidnaps of the localizer, at a time within the run, strictly read like the rest.
+// `faults`: kidnaps of the localizer's belief or of the car, at a time within the run, strictly read like the rest.
 TEST(Scenario, FaultsAreKidnapsWithinTheRun) {
   const std::string base = "world: campus\nduration_s: 20\nego: {route: {road: loop}}\n";
   const Scenario s = parse_scenario(base +
                                         "faults:\n"
                                         "  - {kind: kidnap, at_s: 12.0, offset: [3.0, -2.0], yaw_deg: 2.0}\n"
-                                        "  - {kind: kidnap, at_s: 5, offset: [0, 1]}\n",
+                                        "  - {kind: kidnap, at_s: 5, offset: [0, 1]}\n"
+                                        "  - {kind: kidnap, at_s: 7, offset: [2, 1], moves: car}\n"
+                                        "  - {kind: kidnap, at_s: 9, offset: [2, 1], moves: belief}\n",
                                     "faults.yaml");
-  ASSERT_EQ(s.kidnaps.size(), 2u);
+  ASSERT_EQ(s.kidnaps.size(), 4u);
+  EXPECT_EQ(s.kidnaps[0].moves, KidnapMoves::belief);  // by default
+  EXPECT_EQ(s.kidnaps[2].moves, KidnapMoves::car);
+  EXPECT_EQ(s.kidnaps[3].moves, KidnapMoves::belief);
   EXPECT_EQ(s.kidnaps[0].at_s, 12.0);
   EXPECT_EQ(s.kidnaps[0].offset_m, Eigen::Vector2d(3.0, -2.0));
   EXPECT_NEAR(s.kidnaps[0].yaw_rad, 2.0 * kDeg, 1e-15);
@@ -181,6 +186,8 @@ TEST(Scenario, FaultsAreKidnapsWithinTheRun) {
        "yaw_deg = 270 is out of range"},
       {"unknown key", base + "faults: [{kind: kidnap, at_s: 1, offset: [1, 0], heading: 2}]\n", "4:50",
        "unknown key 'heading'"},
+      {"moves neither", base + "faults: [{kind: kidnap, at_s: 1, offset: [1, 0], moves: world}]\n", "4:57",
+       "moves must be belief or car, got 'world'"},
   };
   expect_rejected(cases);
 }

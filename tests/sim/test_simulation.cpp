@@ -136,5 +136,57 @@ traffic:
   }
 }
 
+// A kidnap of the car: between the scans at 2.9 and 3.0 s the car is set down 3.5 m ahead, 1.5 m left
+// and turned 2 degrees, still moving; the scan from 3.0 s is cast from the new place, the wheels never
+// saw the move, and the car steers back to its lane.
+TEST(Simulation, AKidnapOfTheCarMovesItAndItsSensorsBetweenTwoScans) {
+  const std::string drive = R"(world: campus
+duration_s: 6
+seed: 5
+ego: {route: {road: loop, lane: right}, start_at: 60, speed: 8, initial_speed: 8}
+)";
+  const Eigen::Vector2d offset(3.5, 1.5);
+  const double yaw = 2.0 * kDeg;
+  const Recorder plain = simulate(drive);
+  const Recorder kidnapped = simulate(drive +
+                                      "faults: [{kind: kidnap, at_s: 3.0, offset: [3.5, 1.5], yaw_deg: 2.0, "
+                                      "moves: car}]\n");
+  ASSERT_EQ(plain.truth.size(), kidnapped.truth.size());
+  const auto at = [](const Recorder& r, int64_t t_ns) {
+    for (const TruthSample& s : r.truth)
+      if (s.stamp_ns == t_ns) return s;
+    ADD_FAILURE() << "no truth at " << t_ns;
+    return TruthSample{};
+  };
+  // Before: the same drive.
+  EXPECT_EQ(at(plain, 3'000'000'000).pose.x, at(kidnapped, 3'000'000'000).pose.x);
+  // 10 ms after: where the plain drive is, moved by the offset in its vehicle frame (within the 10 ms the
+  // driver has had to react), at the same speed.
+  const TruthSample p = at(plain, 3'010'000'000), k = at(kidnapped, 3'010'000'000);
+  const Eigen::Vector2d expected = Eigen::Vector2d(p.pose.x, p.pose.y) + Eigen::Rotation2Dd(p.pose.yaw) * offset;
+  EXPECT_LT((Eigen::Vector2d(k.pose.x, k.pose.y) - expected).norm(), 0.005);
+  EXPECT_NEAR(wrap_angle(k.pose.yaw - p.pose.yaw), yaw, 0.002);
+  EXPECT_NEAR(k.speed, p.speed, 0.001);
+  EXPECT_NEAR(k.cross_track - p.cross_track, offset.y(), 0.1);
+  // The scans: the one from 2.9 s is the plain drive's, the one from 3.0 s starts at the new place.
+  ASSERT_EQ(plain.scans.size(), kidnapped.scans.size());
+  EXPECT_TRUE(plain.scans[29].second.isApprox(kidnapped.scans[29].second));
+  const Eigen::Vector3d shift = kidnapped.scans[30].second.translation() - plain.scans[30].second.translation();
+  EXPECT_NEAR(shift.head<2>().norm(), offset.norm(), 0.05);
+  // The wheels did not turn on the way: the CAN frames measured across the move (they arrive 10 ms after)
+  // report the plain drive's wheel speeds, give or take the driver's first reaction.
+  ASSERT_EQ(plain.can.size(), kidnapped.can.size());
+  size_t across = 0;
+  for (size_t i = 0; i < plain.can.size(); ++i)
+    if (plain.can[i].stamp_ns > 3'000'000'000 && plain.can[i].stamp_ns <= 3'050'000'000) {
+      ++across;
+      for (size_t w = 0; w < 4; ++w)
+        EXPECT_NEAR(kidnapped.can[i].wheel_speed_mps[w], plain.can[i].wheel_speed_mps[w], 0.05);
+    }
+  EXPECT_EQ(across, 5u);
+  // And the driver steered back to its lane.
+  EXPECT_LT(std::abs(kidnapped.truth.back().cross_track), 0.3);
+}
+
 }  // namespace
 }  // namespace lidarloop
