@@ -38,7 +38,7 @@ END = "<!-- end generated -->"
 # The scenario suite as CTest runs it (tests/CMakeLists.txt): every scenario at its own seed, and
 # dynamic_campus also at seed 8.
 SUITE = ["static_campus", "dynamic_campus", "bus_occlusion", "straight_road", "intersections", "gps_degraded",
-         "closed_loop_campus", "changed_world", "kidnap", "gps_jump_parked", "cold_start_parked",
+         "closed_loop_campus", "changed_world", "kidnap", "kidnap_car", "gps_jump_parked", "cold_start_parked",
          "busy_street"]
 PAPER_SCENARIOS = [("static", "static_campus", "Table II"), ("dynamic", "dynamic_campus", "Table III")]
 # The paper's methods. The paper-length tables run only these: gicp (not in the paper) costs 35 ms a
@@ -245,11 +245,19 @@ def target_street(r, commands):
                       f"in brackets):\n\n{table}\n"}
 
 
+def availability(integrity):
+    """The share of scored frames a car could use for lane-level driving (not lost, both protection bounds
+    under the alert limits), as `run` prints it."""
+    a = integrity["availability"]
+    return "n/a" if a is None else f"{100.0 * a:.1f} %"
+
+
 def target_suite(r, commands):
     runs = [(name, None) for name in SUITE] + [("dynamic_campus", 8)]
     lines = ["| scenario | seed | result | RMSE lateral m | longitudinal m | heading deg | worst error m | "
-             "mean NEES lateral / longitudinal / heading | misleading frames | curb hidden: run / worst scan |",
-             "|---|---:|---|---:|---:|---:|---:|---|---|---|"]
+             "mean NEES lateral / longitudinal / heading | misleading frames | availability | "
+             "curb hidden: run / worst scan |",
+             "|---|---:|---|---:|---:|---:|---:|---|---|---:|---|"]
     for name, seed in runs:
         out = fresh(os.path.join(WORK, "suite", name + (f"_seed_{seed}" if seed else "")))
         args = ["lidarloop", "run", f"scenarios/{name}.yaml"] + (["--seed", str(seed)] if seed else [])
@@ -267,7 +275,7 @@ def target_suite(r, commands):
         lines.append(f"| `{name}` | {seed_used} | {verdict} | {num(m['lateral_rmse_m'])} | "
                      f"{num(m['longitudinal_rmse_m'])} | {num(m['heading_rmse_deg'])} | "
                      f"{num(m['max_position_error_m'])} | {nees} | {i['misleading_frames']} of "
-                     f"{i['frames_with_bounds']} | {hidden} |")
+                     f"{i['frames_with_bounds']} | {availability(i)} | {hidden} |")
         if name == "dynamic_campus" and not seed:
             picture(os.path.join(out, "worst_frame.png"), "docs/images/worst_frame.png")
             picture(os.path.join(out, "errors.png"), "docs/images/errors.png")
