@@ -13,8 +13,9 @@ namespace lidarloop {
 class LocalizerBackend {
  public:
   // `map` must outlive it. An external program is started here (InputError if it cannot be).
-  // `scenario`: the run's; its kidnaps are done to the localizer before the scans they fall due at
-  // (loop/kidnap_schedule.hpp), which needs a built-in method (InputError naming it otherwise).
+  // `scenario`: the run's; its kidnaps of the belief are done to the localizer before the scans they fall
+  // due at (loop/kidnap_schedule.hpp), which needs a built-in method (InputError naming it otherwise).
+  // A kidnap of the car is in the scans already.
   LocalizerBackend(HdMap& map, const LocalizerParams& params, const Scenario& scenario);
 
   void on_can(const CanFrame& frame);

@@ -54,6 +54,11 @@ class PathController {
 
   // One control step at time t from the pose the controller believes and the measured speed.
   ControllerCommand update(int64_t t_ns, const Pose2d& rear_axle, double speed);
+  // The pose it steers on jumped `along` metres along the path (a kidnap of the car, steered on the
+  // truth): the next update looks for the car there, not within a step of where it was.
+  void jumped(double along) {
+    if (progress_ >= 0) progress_ += along;
+  }
 
  private:
   double project(const Eigen::Vector2d& p, double guess) const;  // arc length near `guess`

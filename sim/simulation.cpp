@@ -63,6 +63,7 @@ Simulation::Simulation(const Scenario& scenario, const WorldDescription& descrip
     if (k.moves == KidnapMoves::car) car_kidnaps_.push_back(k);
   std::stable_sort(car_kidnaps_.begin(), car_kidnaps_.end(),
                    [](const KidnapFault& a, const KidnapFault& b) { return a.at_s < b.at_s; });
+  if (kidnap_the_car()) start_trajectory_here();  // one due at the first scan's start
 }
 
 Simulation::~Simulation() = default;
@@ -86,7 +87,6 @@ void Simulation::advance_to(int64_t t_ns, StreamSink& sink) {
 
 void Simulation::step(StreamSink& sink) {
   const VehicleParams& vp = scenario_.ego.vehicle;
-  if (now_ == trajectory_start_ns_) kidnap_the_car();
   if (now_ % control_period_ns_ == 0) {
     const Pose2d truth = vehicle_.rear_axle_pose();
     const Pose2d believed = pose_source_ ? pose_source_(now_, truth) : truth;
@@ -95,7 +95,7 @@ void Simulation::step(StreamSink& sink) {
   const VehicleState before = vehicle_.state();
   vehicle_.step(command_.command);
   now_ += vp.step_ns;
-  const Pose2d pose = vehicle_.rear_axle_pose();
+  Pose2d pose = vehicle_.rear_axle_pose();
   trajectory_.push_back(pose);
   ground_trajectory_.push_back(contact_of(pose, pavement_, vp));
   if (!scenario_.body.rigid) {
@@ -104,6 +104,11 @@ void Simulation::step(StreamSink& sink) {
                plane_under(pose, ground_trajectory_.back(), vp, scenario_.body));
   }
   body_trajectory_.push_back(body_.attitude());
+  // A scan ends here. A kidnap of the car due now happens at this instant: the scan that ends was cast
+  // from the old place (its trajectory above), everything stamped from now on comes from the new one.
+  const bool scan_ends = now_ - trajectory_start_ns_ >= scenario_.lidar.scan_period_ns();
+  const bool kidnapped = scan_ends && kidnap_the_car();
+  if (kidnapped) pose = vehicle_.rear_axle_pose();
 
   if (now_ % can_.period_ns() == 0) can_.measure(now_, vehicle_.wheel_speeds(), vehicle_.steering_wheel_angle());
   for (const CanFrame& f : can_.deliver(now_)) sink.on_can(f);
@@ -113,13 +118,21 @@ void Simulation::step(StreamSink& sink) {
   }
   if (now_ % gps_.period_ns() == 0) sink.on_gps(gps_.sample(now_, pose));
   if (now_ % rtk_.period_ns() == 0) sink.on_rtk(rtk_.sample(now_, pose));
-  if (now_ - trajectory_start_ns_ >= scenario_.lidar.scan_period_ns()) emit_scan(sink);
+  if (scan_ends) emit_scan(sink);
+  if (kidnapped) start_trajectory_here();
 }
 
-// Between two scans, so that no scan is cast from both places: at the scan start nearest each kidnap's
+void Simulation::start_trajectory_here() {
+  const Pose2d pose = vehicle_.rear_axle_pose();
+  trajectory_.assign(1, pose);
+  ground_trajectory_.assign(1, contact_of(pose, pavement_, scenario_.ego.vehicle));
+  body_trajectory_.assign(1, body_.attitude());
+}
+
+// At a scan's end, so that no scan is cast from both places: at the scan boundary nearest each kidnap's
 // time (from half a scan period before it), as the belief's kidnaps are done (loop/kidnap_schedule.hpp).
-// The scan being recorded starts from the new place; the body keeps its attitude on the new ground.
-void Simulation::kidnap_the_car() {
+// The body is set down on the new ground with its attitude on it. Whether the car moved.
+bool Simulation::kidnap_the_car() {
   const int64_t half_scan = scenario_.lidar.scan_period_ns() / 2;
   bool moved = false;
   for (; next_car_kidnap_ < car_kidnaps_.size(); ++next_car_kidnap_) {
@@ -129,12 +142,15 @@ void Simulation::kidnap_the_car() {
     const double c = std::cos(from.yaw), s = std::sin(from.yaw);
     vehicle_.place({from.x + c * k.offset_m.x() - s * k.offset_m.y(), from.y + s * k.offset_m.x() + c * k.offset_m.y(),
                     wrap_angle(from.yaw + k.yaw_rad)});
+    if (!pose_source_) controller_.jumped(k.offset_m.x());  // closed loop: it steers on the belief, which stayed
     moved = true;
   }
-  if (!moved) return;
-  const Pose2d pose = vehicle_.rear_axle_pose();
-  trajectory_.assign(1, pose);
-  ground_trajectory_.assign(1, contact_of(pose, pavement_, scenario_.ego.vehicle));
+  if (moved) {
+    const VehicleParams& vp = scenario_.ego.vehicle;
+    const Pose2d pose = vehicle_.rear_axle_pose();
+    body_.set_down(plane_under(pose, contact_of(pose, pavement_, vp), vp, scenario_.body));
+  }
+  return moved;
 }
 
 void Simulation::emit_scan(StreamSink& sink) {

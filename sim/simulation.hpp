@@ -67,7 +67,8 @@ class Simulation {
  private:
   void step(StreamSink& sink);
   void emit_scan(StreamSink& sink);
-  void kidnap_the_car();
+  bool kidnap_the_car();
+  void start_trajectory_here();  // the scan being recorded starts from the car's pose now
 
   Scenario scenario_;
   ResolvedScenario resolved_;

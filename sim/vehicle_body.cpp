@@ -130,4 +130,12 @@ void VehicleBody::step(double dt, const Eigen::Vector2d& accel, const GroundPlan
   attitude_.roll = roll_.q - ground.roll;
 }
 
+void VehicleBody::set_down(const GroundPlane& ground) {
+  if (config_.rigid) return;
+  heave_.q += ground.z - ground_.z;
+  pitch_.q += ground.pitch - ground_.pitch;
+  roll_.q += ground.roll - ground_.roll;
+  ground_ = ground;
+}
+
 }  // namespace lidarloop

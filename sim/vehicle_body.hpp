@@ -90,6 +90,10 @@ class VehicleBody {
   // Advances by `dt` under the acceleration `accel` (vehicle frame) with the ground plane now at `ground`.
   void step(double dt, const Eigen::Vector2d& accel, const GroundPlane& ground);
 
+  // The car set down on another ground plane (a kidnap of the car): the body keeps its attitude
+  // relative to the ground and its rates, so the new ground's height and slope are no bump.
+  void set_down(const GroundPlane& ground);
+
   // Relative to the ground plane; all zero (and pivot set) when rigid.
   const BodyAttitude& attitude() const { return attitude_; }
   const BodyConfig& config() const { return config_; }
