@@ -13,7 +13,7 @@ namespace lidarloop {
 // scenario's t = 0 s is stamp 0 (sim/simulation.cpp starts its clock at 0 and records the first truth
 // sample one truth period later), so a fault at `at_s` is at stamp at_s * 1e9.
 //   "start"     at `start_ns`, the run's first truth stamp (the localizer's cold start)
-//   "kidnap"    at each kidnap's at_s
+//   "kidnap"    at the scan start each kidnap is done at, the nearest its at_s
 //   "gps jump"  at each multipath zone's from_s, and "gps jump back" at its to_s, when the fix returns
 //               to the truth (a localizer that held the map's pose through the jump has nothing to be
 //               lost about then: the scorer asks it only to stay converged); only zones in time alone:

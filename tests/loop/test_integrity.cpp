@@ -304,7 +304,8 @@ TEST(PassGates, EachIntegrityAndConsistencyKeyGatesThePass) {
 TEST(FaultEvents, TheStartKidnapsAndTimedGpsJumpsInTimeOrder) {
   Scenario s;
   s.duration_s = 60;
-  s.kidnaps = {{30.0, {3, 0}, 0}, {10.0, {0, 2}, 0}};
+  // Each at the scan start nearest its time: 10.04 s at 10.0 s, 30.06 s at 30.1 s.
+  s.kidnaps = {{30.06, {3, 0}, 0}, {10.04, {0, 2}, 0, KidnapMoves::car}};
   GpsZone jump{GpsZone::Kind::multipath};
   jump.from_ns = 20'000 * kMs, jump.to_ns = 25'000 * kMs, jump.jump_m = {5, 0};
   GpsZone spatial = jump;  // where the car enters it: not known from the scenario
@@ -318,7 +319,7 @@ TEST(FaultEvents, TheStartKidnapsAndTimedGpsJumpsInTimeOrder) {
   const std::vector<FaultEvent> events = fault_events(s, 10 * kMs);  // the first truth sample
   const std::vector<std::pair<int64_t, std::string>> expected = {
       {10 * kMs, "start"},        {5'000 * kMs, "gps jump back"},  {10'000 * kMs, "kidnap"},
-      {20'000 * kMs, "gps jump"}, {25'000 * kMs, "gps jump back"}, {30'000 * kMs, "kidnap"},
+      {20'000 * kMs, "gps jump"}, {25'000 * kMs, "gps jump back"}, {30'100 * kMs, "kidnap"},
       {50'000 * kMs, "gps jump"}};
   ASSERT_EQ(events.size(), expected.size());
   for (size_t i = 0; i < events.size(); ++i) {
