@@ -12,15 +12,8 @@ std::vector<FaultEvent> fault_events(const Scenario& scenario, int64_t start_ns)
   auto add = [&](int64_t stamp_ns, const char* what) {
     if (stamp_ns > start_ns && stamp_ns < scenario.duration_ns()) events.push_back({stamp_ns, what});
   };
-  // A kidnap is done at the scan start nearest its time, from half a scan period before it (as
-  // loop/kidnap_schedule.hpp and the simulation do it): the event is then, so no frame after the move
-  // counts before it.
-  const int64_t period = scenario.lidar.scan_period_ns();
-  for (const KidnapFault& k : scenario.kidnaps) {
-    const int64_t due_from = std::llround(k.at_s * double(kNsPerS)) - period / 2;
-    const int64_t scans = due_from <= 0 ? 0 : (due_from + period - 1) / period;  // the first scan start >= due_from
-    add(scans * period, "kidnap");
-  }
+  // At the scan start the kidnap is done at, so no frame after the move counts before it.
+  for (const KidnapFault& k : scenario.kidnaps) add(kidnap_scan_start_ns(k, scenario.lidar.scan_period_ns()), "kidnap");
   for (const GpsZone& z : scenario.gps.zones) {
     if (z.kind != GpsZone::Kind::multipath || z.radius_m > 0) continue;
     add(z.from_ns, "gps jump");

@@ -596,4 +596,9 @@ ResolvedScenario resolve_scenario(const Scenario& s, const WorldDescription& d, 
   return r;
 }
 
+int64_t kidnap_scan_start_ns(const KidnapFault& kidnap, int64_t scan_period_ns) {
+  const int64_t due_from = std::llround(kidnap.at_s * double(kNsPerS)) - scan_period_ns / 2;
+  return due_from <= 0 ? 0 : (due_from + scan_period_ns - 1) / scan_period_ns * scan_period_ns;
+}
+
 }  // namespace lidarloop

@@ -175,6 +175,9 @@ struct KidnapFault {
   double yaw_rad = 0;
   KidnapMoves moves = KidnapMoves::belief;
 };
+// The scan start a kidnap is done at, on the simulation's clock: the nearest its time, from half a scan
+// period before it (so a scan that starts exactly at at_s takes it).
+int64_t kidnap_scan_start_ns(const KidnapFault& kidnap, int64_t scan_period_ns);
 
 struct Scenario {
   std::string file;

@@ -133,15 +133,11 @@ void Simulation::start_trajectory_here() {
 // time (from half a scan period before it), as the belief's kidnaps are done (loop/kidnap_schedule.hpp).
 // The body is set down on the new ground with its attitude on it. Whether the car moved.
 bool Simulation::kidnap_the_car() {
-  const int64_t half_scan = scenario_.lidar.scan_period_ns() / 2;
   bool moved = false;
   for (; next_car_kidnap_ < car_kidnaps_.size(); ++next_car_kidnap_) {
     const KidnapFault& k = car_kidnaps_[next_car_kidnap_];
-    if (std::llround(k.at_s * double(kNsPerS)) - half_scan > now_) break;
-    const Pose2d from = vehicle_.rear_axle_pose();
-    const double c = std::cos(from.yaw), s = std::sin(from.yaw);
-    vehicle_.place({from.x + c * k.offset_m.x() - s * k.offset_m.y(), from.y + s * k.offset_m.x() + c * k.offset_m.y(),
-                    wrap_angle(from.yaw + k.yaw_rad)});
+    if (kidnap_scan_start_ns(k, scenario_.lidar.scan_period_ns()) > now_) break;
+    vehicle_.place(vehicle_.rear_axle_pose().compose({k.offset_m.x(), k.offset_m.y(), k.yaw_rad}));
     if (!pose_source_) controller_.jumped(k.offset_m.x());  // closed loop: it steers on the belief, which stayed
     moved = true;
   }
