@@ -4,6 +4,7 @@
 #include "logs/tum_file.hpp"
 #include "loop/localizer_setup.hpp"
 #include "mapping/map_cache.hpp"
+#include "sim/ray_scene.hpp"
 
 namespace lidarloop {
 namespace {
@@ -88,6 +89,7 @@ std::unique_ptr<RecordingSink> start_recording(const std::optional<std::string>&
                                   {"loop", scenario.closed_loop ? "closed" : "open"},
                                   {"map_hash", map_hash(scenario.world, scenario_mapping_options(scenario))},
                                   {"realism", realism_name(scenario.realism)},
+                                  {"ray_isa", ray_isa()},
                                   {"realism_overrides", join_lines(realism_overrides(scenario))},
                                   {"version", LIDARLOOP_VERSION}});
   return recorder;

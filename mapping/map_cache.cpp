@@ -21,6 +21,7 @@
 #include "common/path_beside.hpp"
 #include "mapping/file_lock.hpp"
 #include "mapping/survey_plot.hpp"
+#include "sim/ray_scene.hpp"
 #include "sim/world_assets.hpp"
 
 namespace lidarloop {
@@ -95,7 +96,8 @@ std::string map_hash(const std::string& world_name, const MappingOptions& option
     if (entry.path().extension() == ".obj") actors.push_back(entry.path().string());
   std::sort(actors.begin(), actors.end());
   for (const auto& a : actors) hash_file(h, a);
-  hash_bytes(h, options.describe() + " format=" + std::to_string(kMapFormatVersion));
+  // The survey's scans are cast with the pinned kernels (ray_isa): another set makes another map.
+  hash_bytes(h, options.describe() + " format=" + std::to_string(kMapFormatVersion) + " rays=" + ray_isa());
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
   return hex;

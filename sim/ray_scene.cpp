@@ -1,9 +1,12 @@
 #include "sim/ray_scene.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "common/input_error.hpp"
 
 namespace lidarloop {
 
@@ -16,13 +19,52 @@ static void check_device(RTCDevice device, const char* what) {
 // Embree picks its kernels by the processor it runs on (SSE4.2, AVX, AVX2, AVX-512), and they round
 // differently: the same rays hit the same triangles at distances that differ in the last bits, and a
 // closed loop fed those scans drifts apart (kidnap converged 1.6 s after the kidnap with one, 3.4 s with
-// another). SSE4.2 runs on every x86-64-v2 machine (the build's baseline), so every machine casts the
-// same scans and a scenario's log is the same bytes on a laptop, a cluster node and CI (Embree 3 API,
-// rtcNewDevice: the `isa` configuration).
-constexpr const char* kEmbreeIsa = "isa=sse4.2";
+// another). So the kernels are pinned (Embree 3 API, rtcNewDevice: the `isa` configuration), and every
+// machine with the same ones casts the same scans: a scenario's log is the same bytes on a laptop, a
+// cluster node and CI. AVX2 with FMA (x86-64-v3) is on every x86 processor of the last decade, and its
+// 8-wide kernels cast far faster than SSE4.2's (`lidarloop bench lidar` reports both). glibc's
+// libm picks its FMA variants on the same processors, so they agree with each other on the rest of the
+// simulation too. An older processor falls back to SSE4.2, and its scans differ in the last bits.
+namespace {
+constexpr const char* kIsaVariable = "LIDARLOOP_RAY_ISA";
 
-RayScene::RayScene(const TriangleMesh& world, int threads, MeshBuffers buffers) {
-  const std::string config = std::string(kEmbreeIsa) + (threads > 0 ? ",threads=" + std::to_string(threads) : "");
+bool cpu_has(const std::string& isa) {
+#if defined(__x86_64__) || defined(__i386__)
+  if (isa == "sse4.2") return __builtin_cpu_supports("sse4.2");
+  if (isa == "avx2") return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  // Embree's AVX-512 kernels are its Skylake-X ones.
+  if (isa == "avx512")
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+           __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512bw") &&
+           __builtin_cpu_supports("avx512vl");
+#endif
+  (void)isa;
+  return false;
+}
+}  // namespace
+
+std::string ray_isa() {
+  if (const char* env = std::getenv(kIsaVariable); env && *env) {
+    const std::string isa = env;
+    if (isa != "sse4.2" && isa != "avx2" && isa != "avx512")
+      throw InputError(std::string(kIsaVariable) + "=" + isa + ": not one of sse4.2, avx2, avx512");
+    if (!cpu_has(isa)) throw InputError(std::string(kIsaVariable) + "=" + isa + ": this processor does not have it");
+    return isa;
+  }
+#if defined(__x86_64__) || defined(__i386__)
+  return cpu_has("avx2") ? "avx2" : "sse4.2";
+#else
+  return "native";  // Embree's own choice: no other kernels to pin to
+#endif
+}
+
+RayScene::RayScene(const TriangleMesh& world, int threads, MeshBuffers buffers, const std::string& isa) {
+  if (isa != "native" && !cpu_has(isa)) throw std::invalid_argument("RayScene: this processor has no " + isa);
+  std::vector<std::string> settings;
+  if (isa != "native") settings.push_back("isa=" + isa);
+  if (threads > 0) settings.push_back("threads=" + std::to_string(threads));
+  std::string config;
+  for (const std::string& s : settings) config += (config.empty() ? "" : ",") + s;
   device_ = rtcNewDevice(config.c_str());
   if (!device_) throw std::runtime_error("cannot create an Embree device");
   top_ = rtcNewScene(device_);

@@ -8,6 +8,7 @@
 // Actors can also move during a scan: set_actor_motion() gives an instance one transform per
 // keyframe (Embree instance motion blur), and each ray carries its time within the keyframes' span, so
 // a whole scan is cast in one parallel pass with every actor where it was at that ray's instant.
+#include <string>
 #include <vector>
 
 #include <embree3/rtcore.h>
@@ -16,6 +17,13 @@
 #include "sim/triangle_mesh.hpp"
 
 namespace lidarloop {
+
+// The instruction set Embree's kernels are pinned to on this machine ("avx2" where the processor has it
+// and FMA, else "sse4.2"): scans are the same bytes wherever it is the same. The environment variable
+// LIDARLOOP_RAY_ISA picks another (sse4.2, avx2, avx512: AVX-512 casts a quarter faster again, but its
+// scans differ from AVX2's in the last bits); InputError for a name not in that list or a processor
+// without it.
+std::string ray_isa();
 
 struct Ray {
   Eigen::Vector3f origin, direction;  // world frame, unit direction
@@ -37,8 +45,10 @@ class RayScene {
   // mesh must then outlive the scene unchanged. Embree reads the last vertex with a 16-byte load, 4
   // bytes past it: a mesh whose vertex array has no spare capacity for that is copied all the same.
   enum class MeshBuffers { copied, shared };
-  // threads = 0: Embree chooses (all cores). The BVH is deterministic whatever the count.
-  explicit RayScene(const TriangleMesh& world, int threads = 0, MeshBuffers buffers = MeshBuffers::copied);
+  // threads = 0: Embree chooses (all cores). The BVH is deterministic whatever the count. `isa`: the
+  // kernels (ray_isa(), or "sse4.2", "avx2", "avx512" for a benchmark's peer).
+  explicit RayScene(const TriangleMesh& world, int threads = 0, MeshBuffers buffers = MeshBuffers::copied,
+                    const std::string& isa = ray_isa());
   ~RayScene();
   RayScene(const RayScene&) = delete;
   RayScene& operator=(const RayScene&) = delete;

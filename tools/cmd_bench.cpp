@@ -1,5 +1,6 @@
 // lidarloop bench lidar: our scan against bare Embree rtcIntersect1 on the same rays, same scene, same
-// process, alternating so both see the same machine state. Prints one JSON object.
+// process, and against our scan on the same scene built with SSE4.2's kernels (the ISA every x86-64
+// has), alternating so all three see the same machine state. Prints one JSON object.
 #include <algorithm>
 #include <chrono>
 #include <iostream>
@@ -65,12 +66,17 @@ static int bench_lidar(const Args& args) {
       place(ActorType::bus, 12, -lane * 0.6, 0, 0), place(ActorType::car, 60, 2 * lane, M_PI, 10),
       place(ActorType::truck, 30, 0, 0, 8), place(ActorType::pedestrian, 20, 3 * lane, M_PI / 2, 1.4)};
   SceneSetup s = make_scene(world, actors, threads);
+  const std::string isa = ray_isa();
+  // The peer: SSE4.2's kernels, where the pinned ones are others (ray_scene.hpp).
+  std::optional<SceneSetup> sse = isa == "sse4.2" || isa == "native"
+                                      ? std::nullopt
+                                      : std::optional<SceneSetup>(make_scene(world, actors, threads, "sse4.2"));
   const Hdl32eConfig config;
   const LidarScanner scanner(config, s.world.materials);
   const PoseAt trajectory = constant_twist(start, 0, 10.0, 0.0);
   const float tnear = float(config.min_range_m) * 0.5f, tfar = float(config.max_range_m) * 1.05f;
 
-  std::vector<double> ours_ms, bare_ms;
+  std::vector<double> ours_ms, bare_ms, sse_ms;
   double points = 0;
   for (int i = -2; i < scans; ++i) {  // two warm-up scans
     const int64_t stamp = int64_t(std::max(i, 0)) * config.scan_period_ns();
@@ -81,27 +87,39 @@ static int bench_lidar(const Args& args) {
     t0 = Clock::now();
     bare_embree(s.scene->top_level(), rays, tnear, tfar);
     const double bare = ms_since(t0);
+    double sse_ours = 0;
+    if (sse) {
+      t0 = Clock::now();
+      const PointCloud sse_cloud = scanner.scan(*sse->scene, trajectory, stamp, 1, sse->actor_poses);
+      sse_ours = ms_since(t0);
+    }
     if (i < 0) continue;
     ours_ms.push_back(ours);
     bare_ms.push_back(bare);
+    if (sse) sse_ms.push_back(sse_ours);
     points += double(cloud.points.size());
   }
   const double ours = median(ours_ms), bare = median(bare_ms);
   const double realtime = double(config.scan_period_ns()) * 1e-6 / ours;
-  const nlohmann::json result = {{"bench", "lidar"},
-                                 {"world", s.world.world.name},
-                                 {"world_triangles", s.scene->world_triangles()},
-                                 {"actors", actors.size()},
-                                 {"threads", threads},
-                                 {"scans", scans},
-                                 {"rays_per_scan", scanner.rays_per_scan()},
-                                 {"points_per_scan", points / scans},
-                                 {"ms_per_scan", ours},
-                                 {"bare_embree_ms_per_scan", bare},
-                                 {"ratio", ours / bare},
-                                 {"rays_per_s", double(scanner.rays_per_scan()) / ours * 1e3},
-                                 {"realtime_factor", realtime},
-                                 {"realtime_factor_per_core", realtime / threads}};
+  nlohmann::json result = {{"bench", "lidar"},
+                           {"world", s.world.world.name},
+                           {"ray_isa", isa},
+                           {"world_triangles", s.scene->world_triangles()},
+                           {"actors", actors.size()},
+                           {"threads", threads},
+                           {"scans", scans},
+                           {"rays_per_scan", scanner.rays_per_scan()},
+                           {"points_per_scan", points / scans},
+                           {"ms_per_scan", ours},
+                           {"bare_embree_ms_per_scan", bare},
+                           {"ratio", ours / bare},
+                           {"rays_per_s", double(scanner.rays_per_scan()) / ours * 1e3},
+                           {"realtime_factor", realtime},
+                           {"realtime_factor_per_core", realtime / threads}};
+  if (sse) {
+    result["sse42_ms_per_scan"] = median(sse_ms);
+    result["speedup_over_sse42"] = median(sse_ms) / ours;
+  }
   std::cout << result.dump(2) << "\n";
   return 0;
 }

@@ -8,7 +8,14 @@ cd "$(dirname "$0")/.."
 what=${1:-}
 case "$what" in run|test) ;; *) echo "usage: tools/quickstart.sh run|test" >&2; exit 2 ;; esac
 
+# Each phase's wall time, so a slow CI run shows where its minutes went.
+phase_start=$SECONDS
+took() {  # took WHAT: print how long the phase just ended took
+  echo "quickstart: $1 took $((SECONDS - phase_start)) s (${SECONDS} s in all)"
+  phase_start=$SECONDS
+}
 if [ "$what" = run ]; then tools/install_deps.sh run; else tools/install_deps.sh; fi
+took install
 jobs=$(nproc)
 configure() {  # configure DIR [cmake options...]: every option is given each time, so nothing an earlier
                # configuration of DIR left in its cache (say, the tests switched off by `run`) carries over
@@ -39,6 +46,7 @@ if [ "$what" = run ]; then
   if dpkg-query -W -f='${Status}' libopen3d-dev 2>/dev/null | grep -q "install ok installed"; then gicp=ON; fi
   build build -DCMAKE_BUILD_TYPE=Release -DLIDARLOOP_BUILD_TESTS=OFF -DLIDARLOOP_BUILD_BENCHMARKS=OFF \
     -DLIDARLOOP_GICP=$gicp -DLIDARLOOP_SANITIZE=OFF
+  took build
   # Main job: the default dynamic scenario with the localizer in the loop, scored against ground
   # truth (exit 1 if it fails its thresholds).
   exec build/tools/lidarloop run scenarios/dynamic_campus.yaml --out build/out/dynamic_campus
@@ -48,8 +56,10 @@ fi
 # too slow to run instrumented (LIDARLOOP_UNIT_TESTS=slow: tests/CMakeLists.txt lists them and why).
 build build -DCMAKE_BUILD_TYPE=Release -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_BUILD_BENCHMARKS=ON -DLIDARLOOP_GICP=ON \
   -DLIDARLOOP_SANITIZE=OFF -DLIDARLOOP_UNIT_TESTS=slow
+took "optimized build"
 expect_tests build unit cli scenario map node sweep external
 ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs"
+took "optimized tests"
 # Every other unit test under AddressSanitizer and UndefinedBehaviorSanitizer, and the libFuzzer targets
 # (fuzz/) in the same instrumented build, by clang: only what they run is built, at -O1 with line tables
 # only (-g1: file and line in the sanitizers' stack traces), to keep the instrumented build, which CI
@@ -61,6 +71,7 @@ configure build-sanitize -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWith
   -DLIDARLOOP_BUILD_TESTS=ON -DLIDARLOOP_SANITIZE=ON -DLIDARLOOP_FUZZ=ON -DLIDARLOOP_BUILD_BENCHMARKS=OFF -DLIDARLOOP_GICP=ON \
   -DLIDARLOOP_UNITY_BUILD=OFF -DLIDARLOOP_UNIT_TESTS=fast
 cmake --build build-sanitize -j "$jobs" --target unit_tests fuzz_targets
+took "instrumented build"
 expect_tests build-sanitize unit fuzz link
 # With them, every reader of outside files fuzzed for a bounded time (LIDARLOOP_FUZZ_SECONDS each): a
 # crash, a hang, a sanitizer report or an exception other than the reader's InputError fails; and the
@@ -68,3 +79,4 @@ expect_tests build-sanitize unit fuzz link
 # waits with a core idle for another's last test.
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j "$jobs" -L '^(unit|fuzz|link)$'
+took "instrumented tests"

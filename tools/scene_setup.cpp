@@ -29,9 +29,10 @@ ActorPlan parse_actor(const std::string& spec) {
   return straight_actor(*t, {v[0], v[1]}, v[2] * M_PI / 180, fields == 4 ? v[3] : 0.0);
 }
 
-SceneSetup make_scene(const std::string& world, const std::vector<ActorPlan>& actors, int threads) {
+SceneSetup make_scene(const std::string& world, const std::vector<ActorPlan>& actors, int threads,
+                      const std::string& isa) {
   SceneSetup s{load_world(world), nullptr, actors, {}};
-  s.scene = std::make_unique<RayScene>(s.world.world.mesh, threads);
+  s.scene = std::make_unique<RayScene>(s.world.world.mesh, threads, RayScene::MeshBuffers::copied, isa);
   add_actors(*s.scene, actors, actors_dir(), s.world.materials);
   s.actor_poses = actor_motion(actors);
   return s;

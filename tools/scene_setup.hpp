@@ -24,7 +24,8 @@ struct SceneSetup {
   std::vector<ActorPlan> actors;
   ActorPoses actor_poses;  // empty when no actor moves
 };
-SceneSetup make_scene(const std::string& world, const std::vector<ActorPlan>& actors, int threads);
+SceneSetup make_scene(const std::string& world, const std::vector<ActorPlan>& actors, int threads,
+                      const std::string& isa = ray_isa());
 
 // Limits TBB (our loops) to `threads` for as long as it lives.
 std::unique_ptr<tbb::global_control> limit_threads(int threads);

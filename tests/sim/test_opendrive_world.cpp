@@ -127,7 +127,9 @@ TEST(OpenDriveWorld, BrokenCentreLineHasItsPattern) {
   for (const double x : {3.5, 5.0, 8.5, 12.5}) EXPECT_EQ(down(scene, x, 0)->second, material("asphalt")) << x;
   EXPECT_NEAR(down(scene, 1.0, 0)->first, OdrWorldParams().geometry.paint_height, 1e-4);
   for (const double x : {0.5, 2.5, 4.5}) EXPECT_EQ(down(scene, x, -3.5)->second, material("lane_paint")) << x;
-  for (const double x : {1.5, 3.5}) EXPECT_EQ(down(scene, x, -3.5)->second, material("asphalt")) << x;
+  // In the spaces: the lane's asphalt, 3 cm inside the lane (the line's centre is the lane's edge, where
+  // the asphalt and the ground beside it meet in one plane, and either may answer a ray on it).
+  for (const double x : {1.5, 3.5}) EXPECT_EQ(down(scene, x, -3.47)->second, material("asphalt")) << x;
   // Width: 0.12 m from the mark, so 0.05 m off the line is paint and 0.08 m is not.
   EXPECT_EQ(down(scene, 1.0, 0.05)->second, material("lane_paint"));
   EXPECT_EQ(down(scene, 1.0, 0.08)->second, material("asphalt"));

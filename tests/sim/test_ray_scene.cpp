@@ -1,9 +1,14 @@
-// RayScene's mesh buffers: Embree reading the mesh's own arrays casts the same rays as its copy.
+// RayScene's mesh buffers: Embree reading the mesh's own arrays casts the same rays as its copy. Its
+// kernels: pinned by ray_isa(), and every set of them finds the same surfaces.
+#include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
+#include "common/input_error.hpp"
 #include "sim/ray_scene.hpp"
 #include "tests/sim/test_support.hpp"
 
@@ -52,6 +57,78 @@ TEST(RaySceneBuffers, AMeshWithoutSpareCapacityIsCopiedAndCastsTheSame) {
   mesh.vertices.shrink_to_fit();  // may leave it full: then the scene must copy
   const RayScene copied(mesh), shared(mesh, 0, RayScene::MeshBuffers::shared);
   expect_same_hits(copied, shared);
+}
+
+// LIDARLOOP_RAY_ISA set for one test's span, and put back as it was.
+class RayIsaVariable {
+ public:
+  explicit RayIsaVariable(const char* value) {
+    if (const char* old = std::getenv(kName)) old_ = old;
+    ::setenv(kName, value, 1);
+  }
+  ~RayIsaVariable() {
+    if (old_)
+      ::setenv(kName, old_->c_str(), 1);
+    else
+      ::unsetenv(kName);
+  }
+
+ private:
+  static constexpr const char* kName = "LIDARLOOP_RAY_ISA";
+  std::optional<std::string> old_;
+};
+
+#if defined(__x86_64__)
+TEST(RayIsa, PinnedToAvx2WhereTheProcessorHasItAndFma) {
+  const RayIsaVariable unset("");
+  const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  EXPECT_EQ(ray_isa(), avx2 ? "avx2" : "sse4.2");
+}
+#endif
+
+TEST(RayIsa, TheVariableMustNameAKnownSet) {
+  const RayIsaVariable bad("avx3");
+  try {
+    ray_isa();
+    FAIL() << "no error for an unknown ISA";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("LIDARLOOP_RAY_ISA=avx3"), std::string::npos) << e.what();
+  }
+  const RayIsaVariable sse("sse4.2");
+  EXPECT_EQ(ray_isa(), "sse4.2");
+}
+
+// A known plane: every set of kernels the processor has puts the street's ground at the range a ray's
+// geometry gives (float rounding apart), and the walls, pole and sky where the pinned set does.
+TEST(RayIsa, EveryKernelSetFindsTheSameSurfaces) {
+  const TriangleMesh mesh = street();
+  const RayScene pinned(mesh);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1, 1);
+  for (const char* isa : {"sse4.2", "avx2", "avx512"}) {
+    std::optional<RayScene> other;
+    try {
+      other.emplace(mesh, 0, RayScene::MeshBuffers::copied, isa);
+    } catch (const std::exception&) {
+      continue;  // not on this processor
+    }
+    int ground = 0;
+    for (int i = 0; i < 5000; ++i) {
+      const Ray ray{{u(rng) * 2, u(rng) * 2, 1.8f}, Eigen::Vector3f(u(rng), u(rng), u(rng) - 0.3f).normalized(), 0};
+      RayHit a, b;
+      const bool found_a = pinned.intersect(ray, 0, 100, a), found_b = other->intersect(ray, 0, 100, b);
+      ASSERT_EQ(found_a, found_b) << isa << " ray " << i;
+      if (!found_a) continue;
+      EXPECT_EQ(a.material, b.material) << isa << " ray " << i;
+      EXPECT_NEAR(a.range, b.range, 1e-5f * a.range) << isa << " ray " << i;
+      // The ground is z = 0: a ray down from 1.8 m meets it at 1.8 / -d_z unless something stands nearer.
+      if (a.normal.z() > 0.999f && ray.direction.z() < -0.05f) {
+        EXPECT_NEAR(b.range, 1.8f / -ray.direction.z(), 2e-5f * b.range) << isa << " ray " << i;
+        ++ground;
+      }
+    }
+    EXPECT_GT(ground, 1000) << isa;
+  }
 }
 
 }  // namespace
