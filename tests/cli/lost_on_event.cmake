@@ -6,7 +6,9 @@
 # fixes then show), and for the built-in localizer on kidnap_car. The run itself may fail the scenario's
 # thresholds (exit 1): a CAN + GPS filter is metres off, and the built-in localizer's recovery after a
 # kidnap of the car takes longer than kidnap_car allows (docs/scenarios.md).
-# -DLIDARLOOP=... -DSCENARIO=... -DMETHOD=... -DWORKDIR=... [-DEVENT="gps jump" (default) or kidnap]
+# -DMAX_MISLEADING=N also fails a run with more misleading frames (integrity.misleading_frames) than N.
+# -DLIDARLOOP=... -DSCENARIO=... -DMETHOD=... -DWORKDIR=... [-DEVENT="gps jump" (default), kidnap or start]
+# [-DMAX_MISLEADING=N]
 if(NOT DEFINED EVENT)
   set(EVENT "gps jump")
 endif()
@@ -24,6 +26,12 @@ string(JSON frames GET "${metrics}" frames)
 math(EXPR bounded "${bounded} + ${awaiting}")
 if(NOT bounded EQUAL frames)
   message(FATAL_ERROR "${bounded} of ${frames} frames carry protection bounds: the example gives them with every pose")
+endif()
+if(DEFINED MAX_MISLEADING)
+  string(JSON misleading GET "${metrics}" integrity misleading_frames)
+  if(misleading GREATER MAX_MISLEADING)
+    message(FATAL_ERROR "${misleading} misleading frames (at most ${MAX_MISLEADING})")
+  endif()
 endif()
 string(JSON lost_within GET "${metrics}" thresholds recovery lost_within_s)
 string(JSON events LENGTH "${metrics}" recovery)
