@@ -18,11 +18,18 @@
 
 namespace lidarloop {
 
-// The instruction set Embree's kernels are pinned to on this machine ("avx2" where the processor has it
-// and FMA, else "sse4.2"): scans are the same bytes wherever it is the same. The environment variable
-// LIDARLOOP_RAY_ISA picks another (sse4.2, avx2, avx512: AVX-512 casts a quarter faster again, but its
-// scans differ from AVX2's in the last bits); InputError for a name not in that list or a processor
-// without it.
+// The sets of Embree kernels a scene can be pinned to. `native`: Embree's own choice, unpinned (the only
+// one off x86, where there is no other set to pin to).
+inline constexpr const char* kRayIsaSse42 = "sse4.2";
+inline constexpr const char* kRayIsaAvx2 = "avx2";
+inline constexpr const char* kRayIsaAvx512 = "avx512";
+inline constexpr const char* kRayIsaNative = "native";
+
+// The kernels ray casting is pinned to on this machine: AVX2's where the processor has AVX2 and FMA, else
+// SSE4.2's (native off x86). Scans are the same bytes wherever the set is the same. The environment
+// variable LIDARLOOP_RAY_ISA picks another (sse4.2, avx2, avx512: AVX-512's cast faster still where the
+// processor has it, but its scans differ from AVX2's in the last bits; native); InputError for a name
+// not in that list or a processor without it.
 std::string ray_isa();
 
 struct Ray {
@@ -46,7 +53,7 @@ class RayScene {
   // bytes past it: a mesh whose vertex array has no spare capacity for that is copied all the same.
   enum class MeshBuffers { copied, shared };
   // threads = 0: Embree chooses (all cores). The BVH is deterministic whatever the count. `isa`: the
-  // kernels (ray_isa(), or "sse4.2", "avx2", "avx512" for a benchmark's peer).
+  // kernels (ray_isa(), or another set for a benchmark's peer); InputError for one this processor lacks.
   explicit RayScene(const TriangleMesh& world, int threads = 0, MeshBuffers buffers = MeshBuffers::copied,
                     const std::string& isa = ray_isa());
   ~RayScene();

@@ -25,6 +25,7 @@
 #include "loop/run_recording.hpp"
 #include "mapping/map_cache.hpp"
 #include "scoring/result_files.hpp"
+#include "sim/ray_scene.hpp"
 #include "tools/commands.hpp"
 
 namespace lidarloop {
@@ -73,10 +74,19 @@ int run_replay(const Args& args) {
               << "the vehicle is read from " << *run.vehicle_from << ", which may have changed since\n";
   const auto recorded_map = run.metadata.find("map_hash");
   const std::string map_now = map_hash(scenario.world, scenario_mapping_options(scenario));
-  if (recorded_map != run.metadata.end() && recorded_map->second != map_now)
+  if (recorded_map != run.metadata.end() && recorded_map->second != map_now) {
+    // The map's hash also names the kernels its survey was cast with (sim/ray_scene.hpp).
+    const auto recorded_isa = run.metadata.find("ray_isa");
+    const std::string isa_now = ray_isa();
+    std::string why = "its world, materials or actors changed";
+    if (recorded_isa == run.metadata.end())
+      why = "it was recorded before logs named their ray-casting kernels, or its world, materials or actors changed";
+    else if (recorded_isa->second != isa_now)
+      why = "its scans were cast with " + recorded_isa->second + " kernels and this machine's map with " + isa_now;
     std::cerr << "lidarloop: note: the map of world '" << scenario.world << "' is not the one " << log
-              << " was recorded with (hash " << map_now << ", recorded " << recorded_map->second
-              << "): its world, materials or actors changed, and the estimates may differ from the run's\n";
+              << " was recorded with (hash " << map_now << ", recorded " << recorded_map->second << "): " << why
+              << ", and the estimates may differ from the run's\n";
+  }
   const LoadedWorld world = load_scenario_world(scenario);
   const ResolvedScenario resolved = resolve_scenario(scenario, world.description, world.world);
   HdMap map = open_scenario_map(scenario, world);

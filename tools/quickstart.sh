@@ -8,7 +8,8 @@ cd "$(dirname "$0")/.."
 what=${1:-}
 case "$what" in run|test) ;; *) echo "usage: tools/quickstart.sh run|test" >&2; exit 2 ;; esac
 
-# Each phase's wall time, so a slow CI run shows where its minutes went.
+# Each phase's wall time (the main job's own line says how long it ran), so a slow CI run shows where its
+# minutes went.
 phase_start=$SECONDS
 took() {  # took WHAT: print how long the phase just ended took
   echo "quickstart: $1 took $((SECONDS - phase_start)) s (${SECONDS} s in all)"

@@ -8,6 +8,7 @@
 
 #include "sim/actor_assets.hpp"
 #include "sim/lidar_scanner.hpp"
+#include "sim/ray_scene.hpp"
 #include "sim/traffic.hpp"
 #include "sim/world_assets.hpp"
 
