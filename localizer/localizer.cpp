@@ -605,19 +605,31 @@ std::optional<Pose2d> Localizer::curb_correction(const std::vector<Eigen::Vector
 }
 
 // 3.3: the curb observation (x, y, psi) into KF2, if it passes the innovation gate.
+// While lost, the filter's heading is in doubt as far as the search's (search_sigmas_): after a kidnap
+// of the car the filter, told nothing, keeps its old heading and the certainty it had, and would refuse
+// every curb match that turns it back once the position is found again. So a match that leaves the
+// position where it is (within the step that restarts the search: see process_scan) is judged with that
+// doubt, which is added only if the match passes. One that moves the position is judged as always: it
+// would restart the search, which places the car along the road as curbs cannot.
 void Localizer::fuse_curbs(const PoseObservation& z, LocalizerEstimate& e) {
-  if (!fuse_pose(z, curb_rejections_, e)) e.health |= kCurbMatchRejected;
+  Eigen::Matrix3d doubt = Eigen::Matrix3d::Zero();
+  const Eigen::Vector2d moves(z.pose.x - filter_->pose().x, z.pose.y - filter_->pose().y);
+  if (lost_.lost() && moves.norm() <= params_.aps.step_m)
+    doubt(2, 2) = std::max(0.0, search_sigmas_.z() * search_sigmas_.z() - filter_->covariance()(2, 2));
+  if (!fuse_pose(z, curb_rejections_, e, doubt)) e.health |= kCurbMatchRejected;
 }
 
-bool Localizer::fuse_pose(const PoseObservation& z, int& rejections, LocalizerEstimate& e) {
+bool Localizer::fuse_pose(const PoseObservation& z, int& rejections, LocalizerEstimate& e,
+                          const Eigen::Matrix3d& doubt) {
   const StageTimer timer(stage_ms(e, Stage::fusion));
   const Pose2d prior = filter_->pose();
   const Eigen::Vector3d innovation(z.pose.x - prior.x, z.pose.y - prior.y, wrap_angle(z.pose.yaw - prior.yaw));
-  const Eigen::Matrix3d S = filter_->covariance() + z.covariance;
+  const Eigen::Matrix3d S = filter_->covariance() + doubt + z.covariance;
   if (!gate(innovation.dot(S.ldlt().solve(innovation)), params_.health.gate_curb, rejections)) {
     disagree(innovation.head<2>());
     return false;
   }
+  if (!doubt.isZero()) filter_->inflate(doubt);
   filter_->update_curb(Eigen::Vector3d(z.pose.x, z.pose.y, z.pose.yaw), z.covariance);  // KF2
   // Curbs along a straight road say nothing of the position along it.
   const Eigen::Vector2d forward(std::cos(prior.yaw), std::sin(prior.yaw));

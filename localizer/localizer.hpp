@@ -166,7 +166,9 @@ class Localizer {
                                         const Pose2d& prior);
   void fuse_curbs(const PoseObservation& z, LocalizerEstimate& e);
   // The KF2 update (x, y, psi) behind the chi^2 gate; false if the gate refused it.
-  bool fuse_pose(const PoseObservation& z, int& rejections, LocalizerEstimate& e);
+  // `doubt`: added to the filter's covariance for this observation, if the gate lets it through.
+  bool fuse_pose(const PoseObservation& z, int& rejections, LocalizerEstimate& e,
+                 const Eigen::Matrix3d& doubt = Eigen::Matrix3d::Zero());
   std::optional<PoseObservation> match_points(const ScanPoints& points, LocalizerEstimate& e);
   std::optional<ApsResult> match_intensity(IntensityGrid& S, LocalizerEstimate& e);
   ApsParams aps_window(const Pose2d& prior) const;
