@@ -22,9 +22,10 @@ static void check_device(RTCDevice device, const char* what) {
 // another). So the kernels are pinned (Embree 3 API, rtcNewDevice: the `isa` configuration), and every
 // machine with the same ones casts the same scans: a scenario's log is the same bytes on a laptop, a
 // cluster node and CI. AVX2 with FMA is on most x86 processors made since 2015 (not some Pentium,
-// Celeron and Atom parts), and its 8-wide kernels cast a campus scan about 1.3 times as fast as SSE4.2's (`lidarloop
-// bench lidar` times both). glibc's libm picks its FMA variants on the same processors, so the rest of the simulation
-// agrees too. An older processor falls back to SSE4.2, and its scans differ in the last bits.
+// Celeron and Atom parts), and its 8-wide kernels cast a campus scan about 1.3 times as fast as
+// SSE4.2's (`lidarloop bench lidar` times both). glibc's libm picks its FMA variants on the same
+// processors, so the rest of the simulation agrees too. An older processor falls back to SSE4.2, and
+// its scans differ in the last bits.
 namespace {
 constexpr const char* kIsaVariable = "LIDARLOOP_RAY_ISA";
 
