@@ -5,7 +5,7 @@
 #include <chrono>
 #include <iostream>
 #include <limits>
-#include <optional>
+#include <memory>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -69,8 +69,8 @@ static int bench_lidar(const Args& args) {
   SceneSetup s = make_scene(world, actors, threads);
   const std::string isa = ray_isa();
   // The peer: SSE4.2's kernels, where the pinned ones are others (ray_scene.hpp).
-  std::optional<SceneSetup> sse;
-  if (isa != kRayIsaSse42 && isa != kRayIsaNative) sse.emplace(make_scene(world, actors, threads, kRayIsaSse42));
+  std::unique_ptr<RayScene> sse;
+  if (isa != kRayIsaSse42 && isa != kRayIsaNative) sse = ray_scene(s.world, actors, threads, kRayIsaSse42);
   const Hdl32eConfig config;
   const LidarScanner scanner(config, s.world.materials);
   const PoseAt trajectory = constant_twist(start, 0, 10.0, 0.0);
@@ -90,7 +90,7 @@ static int bench_lidar(const Args& args) {
     double sse_ours = 0;
     if (sse) {
       t0 = Clock::now();
-      scanner.scan(*sse->scene, trajectory, stamp, 1, sse->actor_poses);
+      scanner.scan(*sse, trajectory, stamp, 1, s.actor_poses);
       sse_ours = ms_since(t0);
     }
     if (i < 0) continue;

@@ -29,11 +29,16 @@ ActorPlan parse_actor(const std::string& spec) {
   return straight_actor(*t, {v[0], v[1]}, v[2] * M_PI / 180, fields == 4 ? v[3] : 0.0);
 }
 
-SceneSetup make_scene(const std::string& world, const std::vector<ActorPlan>& actors, int threads,
-                      const std::string& isa) {
+std::unique_ptr<RayScene> ray_scene(const LoadedWorld& world, const std::vector<ActorPlan>& actors, int threads,
+                                    const std::string& isa) {
+  auto scene = std::make_unique<RayScene>(world.world.mesh, threads, RayScene::MeshBuffers::copied, isa);
+  add_actors(*scene, actors, actors_dir(), world.materials);
+  return scene;
+}
+
+SceneSetup make_scene(const std::string& world, const std::vector<ActorPlan>& actors, int threads) {
   SceneSetup s{load_world(world), nullptr, actors, {}};
-  s.scene = std::make_unique<RayScene>(s.world.world.mesh, threads, RayScene::MeshBuffers::copied, isa);
-  add_actors(*s.scene, actors, actors_dir(), s.world.materials);
+  s.scene = ray_scene(s.world, actors, threads);
   s.actor_poses = actor_motion(actors);
   return s;
 }

@@ -25,8 +25,10 @@ struct SceneSetup {
   std::vector<ActorPlan> actors;
   ActorPoses actor_poses;  // empty when no actor moves
 };
-SceneSetup make_scene(const std::string& world, const std::vector<ActorPlan>& actors, int threads,
-                      const std::string& isa = ray_isa());
+SceneSetup make_scene(const std::string& world, const std::vector<ActorPlan>& actors, int threads);
+// A loaded world and its actors as a ray scene, cast with the kernels `isa` (a benchmark's peer).
+std::unique_ptr<RayScene> ray_scene(const LoadedWorld& world, const std::vector<ActorPlan>& actors, int threads,
+                                    const std::string& isa = ray_isa());
 
 // Limits TBB (our loops) to `threads` for as long as it lives.
 std::unique_ptr<tbb::global_control> limit_threads(int threads);
