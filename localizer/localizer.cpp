@@ -634,7 +634,7 @@ bool Localizer::fuse_pose(const PoseObservation& z, int& rejections, LocalizerEs
   // Curbs along a straight road say nothing of the position along it.
   const Eigen::Vector2d forward(std::cos(prior.yaw), std::sin(prior.yaw));
   const double along_sigma = std::sqrt(forward.dot(z.covariance.topLeftCorner<2, 2>() * forward));
-  agree(prior, along_sigma <= params_.lost.converged_sigma_m, true);
+  agree(prior, innovation.head<2>(), along_sigma <= params_.lost.converged_sigma_m, true);
   return true;
 }
 
@@ -798,7 +798,7 @@ void Localizer::fuse_intensity(const ApsResult& aps, const IntensityGrid& grid, 
     // Learnt while tracking only: lost, the filter's own variance is not yet to be believed.
     if (!lost_.lost())
       scale.add(nu, prior_variance, {along ? claimed_variance.x() : unused, across ? claimed_variance.y() : unused});
-    agree(prior, along, across);
+    agree(prior, innovation, along, across);
   }
 }
 
@@ -824,9 +824,9 @@ double Localizer::position_sigma() const {
   return std::sqrt(filter_->covariance().topLeftCorner<2, 2>().eigenvalues().real().maxCoeff());
 }
 
-void Localizer::agree(const Pose2d& prior, bool along, bool across) {
+void Localizer::agree(const Pose2d& prior, const Eigen::Vector2d& innovation, bool along, bool across) {
   const bool was_lost = lost_.lost();
-  lost_.agree(along, across, position_sigma());
+  lost_.agree(along, across, position_sigma(), Eigen::Rotation2Dd(-prior.yaw) * innovation);
   if (!lost_.lost()) {
     if (was_lost) {
       // Found and confirmed (perhaps by the narrow matchers while a search ran): the search ends, and

@@ -189,7 +189,7 @@ class Localizer {
   void disagree(const Eigen::Vector2d& innovation, bool gps = false);
   void judge_gps_jump(const Pose2d& placed);
   // A map match the filter took (updated from `prior`), pinning down these axes of the car.
-  void agree(const Pose2d& prior, bool along, bool across);
+  void agree(const Pose2d& prior, const Eigen::Vector2d& innovation, bool along, bool across);
   // Whether APS's innovation along the road, informative by itself, may update the filter, its window on
   // that axis `grown` to the prior's spread (see the .cpp).
   bool confirmed_along(bool informative, bool grown, double innovation_along);

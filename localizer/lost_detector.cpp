@@ -1,5 +1,7 @@
 #include "localizer/lost_detector.hpp"
 
+#include <cmath>
+
 #include "common/units.hpp"
 
 namespace lidarloop {
@@ -17,10 +19,10 @@ void LostDetector::disagree(const Disagreement& d) {
   if (int(recent_.size()) >= p_.min_disagreements) start_search();
 }
 
-void LostDetector::agree(bool along, bool across, double position_sigma_m) {
+void LostDetector::agree(bool along, bool across, double position_sigma_m, const Eigen::Vector2d& innovation) {
   if (!lost_) return;
-  agreements_along_ += along;
-  agreements_across_ += across;
+  agreements_along_ += along && std::abs(innovation.x()) <= p_.converged_sigma_m;
+  agreements_across_ += across && std::abs(innovation.y()) <= p_.converged_sigma_m;
   // Confirmed: a found pose that enough matches agree with, or a cold start the narrow matchers
   // converged on their own.
   const bool agreed = agreements_along_ >= p_.confirmations && agreements_across_ >= p_.confirmations;

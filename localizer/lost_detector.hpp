@@ -26,6 +26,8 @@ struct LostParams {
   int confirmations = 3;
   // Cold start: the filter counts as converged once its position sigma (largest axis, m) is this small
   // and a map match agreed with it (the map matchers' grown windows found it without a wide search).
+  // A match agrees, on an axis it pinned down, only if the filter's pose was within this of it there: one
+  // that pulls the filter metres (a filter still converging) confirms nothing yet.
   double converged_sigma_m = 0.3;
 };
 
@@ -43,8 +45,9 @@ class LostDetector {
   // A cold start (or a forced relocalization): lost, and a wide search wanted.
   void start_search();
   void disagree(const Disagreement& d);
-  // A map match the filter accepted, and the axes (of the car) it pinned down.
-  void agree(bool along, bool across, double position_sigma_m);
+  // A map match the filter accepted, the axes (of the car) it pinned down, and its innovation on them
+  // (along, across: the match's position less the filter's before the update, m).
+  void agree(bool along, bool across, double position_sigma_m, const Eigen::Vector2d& innovation = {0, 0});
   // A wide search found a pose and the filter was put there: now to be confirmed.
   void found();
 

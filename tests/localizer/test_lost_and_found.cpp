@@ -67,6 +67,26 @@ TEST(LostDetector, RaisedByEnoughDisagreementsInTheWindowClearedByAgreementOnBot
   EXPECT_FALSE(d.lost());
 }
 
+TEST(LostDetector, AColdStartStillPulledAlongTheRoadIsNotConverged) {
+  // intersections seed 2: APS pulled a cold start 0.3 m back every scan, from 3 m off, while the
+  // filter's sigma was already under the converged one. Those matches confirm nothing.
+  LostDetector d;
+  const LostParams p;
+  d.start_search();
+  const double sigma = 0.9 * p.converged_sigma_m, pull = 1.5 * p.converged_sigma_m;
+  for (int k = 0; k < 10; ++k) {
+    d.agree(true, false, sigma, {pull, 0.0});  // APS along, still moving the filter
+    d.agree(false, true, sigma, {0.0, 0.01});  // curbs across
+  }
+  EXPECT_TRUE(d.lost());
+  // Once the matches find the filter where they are, it has converged.
+  for (int k = 0; k < p.confirmations; ++k) {
+    d.agree(true, false, sigma, {0.5 * p.converged_sigma_m, 0.0});
+    d.agree(false, true, sigma, {0.0, 0.01});
+  }
+  EXPECT_FALSE(d.lost());
+}
+
 TEST(LostDetector, DisagreementsSpreadOverTimeDoNotRaiseIt) {
   LostDetector d;
   for (int k = 0; k < 20; ++k) d.disagree({k * 2 * kFixNs * 2, {1, 0}});  // one every 0.4 s
