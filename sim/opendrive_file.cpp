@@ -118,6 +118,15 @@ struct Reader {
     if (!v) where.fail(n, road, std::nullopt, std::string(n.name()) + " has no " + key);
     return *v;
   }
+  // A revision number: whole, and small enough for an int (a fuzzed 7e114 is not undefined behaviour).
+  int revision(const pugi::xml_node& n, const char* key, int fallback) const {
+    const double v = number(n, key, fallback);
+    if (v != std::floor(v) || v < 0 || v > kMaxRevision)
+      where.fail(n, road, std::nullopt,
+                 std::string(n.name()) + " " + key + " is not a revision number: " + quoted(n.attribute(key).value()));
+    return int(v);
+  }
+  static constexpr double kMaxRevision = 1e6;
   int integer(const pugi::xml_node& n, const char* key) const {
     const double v = required(n, key);
     if (v != std::floor(v) || std::abs(v) > 1e6)
@@ -618,8 +627,8 @@ OdrMap parse(const std::string& xml, const std::string& name, const OdrReadOptio
   const pugi::xml_node header = root.child("header");
   if (!header) where.fail(root, "", std::nullopt, "OpenDRIVE without a header");
   Reader r{where, ""};
-  map.rev_major = int(r.number(header, "revMajor", 1));
-  map.rev_minor = int(r.number(header, "revMinor", 4));
+  map.rev_major = r.revision(header, "revMajor", 1);
+  map.rev_minor = r.revision(header, "revMinor", 4);
   if (map.rev_major != 1)
     where.fail(header, "", std::nullopt, "OpenDRIVE " + std::to_string(map.rev_major) + ".x is not 1.x");
   if (map.rev_minor < 4 || map.rev_minor > 8)

@@ -305,6 +305,9 @@ TEST(OpenDriveFile, BadInputIsOneLineNamingFileRoadAndS) {
   const Case cases[] = {
       {"<OpenDRIVE><header>", "bad.xodr:1: not XML"},
       {"<?xml version=\"1.0\"?>\n<osm version=\"0.6\"/>", "bad.xodr:2: not an OpenDRIVE file"},
+      // The fuzzer's: a revision beyond an int's range was converted to int, undefined behaviour.
+      {"<?xml version=\"1.0\"?>\n<OpenDRIVE><header revMajor=\"1\" revMinor=\"7e114\"/></OpenDRIVE>",
+       "header revMinor is not a revision number: '7e114'"},
       {map_text(road("7", 10, "<clothoid/>", good_lanes)), "road 7 at s=0: unknown geometry 'clothoid'"},
       {map_text(road("7", 10, "<line/>", good_lanes,
                      "    <link><successor elementType=\"road\" elementId=\"42\" contactPoint=\"start\"/></link>\n")),
