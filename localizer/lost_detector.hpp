@@ -47,7 +47,7 @@ class LostDetector {
   void disagree(const Disagreement& d);
   // A map match the filter accepted, the axes (of the car) it pinned down, and its innovation on them
   // (along, across: the match's position less the filter's before the update, m).
-  void agree(bool along, bool across, double position_sigma_m, const Eigen::Vector2d& innovation = {0, 0});
+  void agree(bool along, bool across, double position_sigma_m, const Eigen::Vector2d& innovation);
   // A wide search found a pose and the filter was put there: now to be confirmed.
   void found();
 

@@ -118,21 +118,20 @@ struct Reader {
     if (!v) where.fail(n, road, std::nullopt, std::string(n.name()) + " has no " + key);
     return *v;
   }
-  // A revision number: whole, and small enough for an int (a fuzzed 7e114 is not undefined behaviour).
-  int revision(const pugi::xml_node& n, const char* key, int fallback) const {
-    const double v = number(n, key, fallback);
-    if (v != std::floor(v) || v < 0 || v > kMaxRevision)
+  // Lane ids and revision numbers: whole and within +-kMaxWhole, so that the int they become holds them
+  // (a fuzzed 7e114 converted to int is undefined behaviour).
+  static constexpr double kMaxWhole = 1e6;
+  int whole(const pugi::xml_node& n, const char* key, double v, double lowest, const char* what) const {
+    if (v != std::floor(v) || v < lowest || v > kMaxWhole)
       where.fail(n, road, std::nullopt,
-                 std::string(n.name()) + " " + key + " is not a revision number: " + quoted(n.attribute(key).value()));
+                 std::string(n.name()) + " " + key + " is not " + what + ": " + quoted(n.attribute(key).value()));
     return int(v);
   }
-  static constexpr double kMaxRevision = 1e6;
+  int revision(const pugi::xml_node& n, const char* key, int fallback) const {
+    return whole(n, key, number(n, key, fallback), 0, "a revision number");
+  }
   int integer(const pugi::xml_node& n, const char* key) const {
-    const double v = required(n, key);
-    if (v != std::floor(v) || std::abs(v) > 1e6)
-      where.fail(n, road, std::nullopt,
-                 std::string(n.name()) + " " + key + " is not a lane id: " + quoted(n.attribute(key).value()));
-    return int(v);
+    return whole(n, key, required(n, key), -kMaxWhole, "a lane id");
   }
   OdrCubic cubic(const pugi::xml_node& n, const char* s_key, double base) const {
     return {base + required(n, s_key), number(n, "a", 0), number(n, "b", 0), number(n, "c", 0), number(n, "d", 0)};

@@ -61,9 +61,9 @@ TEST(LostDetector, RaisedByEnoughDisagreementsInTheWindowClearedByAgreementOnBot
   EXPECT_TRUE(d.searching());
   d.found();
   EXPECT_FALSE(d.searching());
-  for (int k = 0; k < 3; ++k) d.agree(false, true, 0.05);  // across only: a straight road's curbs
+  for (int k = 0; k < 3; ++k) d.agree(false, true, 0.05, {0, 0});  // across only: a straight road's curbs
   EXPECT_TRUE(d.lost());
-  for (int k = 0; k < 3; ++k) d.agree(true, false, 0.05);
+  for (int k = 0; k < 3; ++k) d.agree(true, false, 0.05, {0, 0});
   EXPECT_FALSE(d.lost());
 }
 
