@@ -203,10 +203,16 @@ Localizer::Localizer(HdMap& map, const LocalizerParams& params)
       relocalizer_(params.relocalization),
       body_roll_(params.body_roll) {}
 
+PoseFilterParams Localizer::filter_params() const {
+  PoseFilterParams p = params_.filter;
+  if (params_.mount_uncertainty.learn_yaw) p.mount_yaw_sigma_rad = params_.mount_uncertainty.yaw_sigma_deg / kDegPerRad;
+  return p;
+}
+
 void Localizer::initialize(int64_t stamp_ns, const Pose2d& pose, const Eigen::Matrix3d& covariance) {
   predict_to(stamp_ns);
   relocalizer_.finish();
-  filter_.emplace(pose, covariance, params_.filter);
+  filter_.emplace(pose, covariance, filter_params());
 }
 
 void Localizer::displace(const Pose2d& offset) {
@@ -216,7 +222,7 @@ void Localizer::displace(const Pose2d& offset) {
 
 std::optional<Pose2d> Localizer::pose() const {
   if (!filter_) return std::nullopt;
-  return filter_->pose();
+  return filter_->car_pose();
 }
 
 void Localizer::predict_to(int64_t t_ns) {
@@ -229,7 +235,7 @@ void Localizer::predict_to(int64_t t_ns) {
   if (!filter_) return;
   // The filter moves by the odometry's increment in its own frame.
   const Pose2d step = relative(before, odometry_);
-  filter_->predict(filter_->pose().compose(step), std::hypot(step.x, step.y), dt);
+  filter_->predict(filter_->car_pose().compose(step), std::hypot(step.x, step.y), dt);
   const bool can_stale = !last_can_ns_ || double(t_ns - *last_can_ns_) / kNsPerS > params_.health.can_timeout_s;
   if (can_stale) {
     const double q = params_.process_position_without_can_per_s;
@@ -260,7 +266,7 @@ void Localizer::on_gps(const GpsFix& fix) {
   predict_to(fix.stamp_ns);
   // The fix is the antenna's; the rear axle is the lever arm behind it, turned by the heading (the
   // filter's when it has one: the receiver's heading is the worse by far).
-  const double heading = filter_ ? filter_->pose().yaw : fix.heading_rad;
+  const double heading = filter_ ? filter_->car_pose().yaw : fix.heading_rad;
   const Eigen::Vector2d p =
       frame_.to_local(fix.lat_deg, fix.lon_deg) - Eigen::Rotation2Dd(heading) * params_.gps_antenna.head<2>();
   const GpsNoise& n = params_.gps_noise;
@@ -279,7 +285,7 @@ void Localizer::on_gps(const GpsFix& fix) {
   if (!filter_) {
     // A cold start: lost until the map has pinned the pose down.
     // One fix is as good as the receiver says; a scale is for the correlation between many.
-    filter_ = PoseFilter::from_gps_fix(z, gps_error_model(reported), params_.filter);
+    filter_ = PoseFilter::from_gps_fix(z, gps_error_model(reported), filter_params());
     last_fix_ = {filter_->pose(), R, odometry_};
     lost_.start_search();
     trusted_.reset();
@@ -987,10 +993,14 @@ void Localizer::judge_gps_jump(const Pose2d& placed) {
 
 void Localizer::report_pose(LocalizerEstimate& e) {
   if (filter_) {
-    e.pose = filter_->pose();
+    e.pose = filter_->car_pose();
+    // The calibration's residual on top of the filter's doubt (a consider term), but for a mount yaw the
+    // filter learns: its doubt of that is in the car's covariance already.
     const MountUncertainty& m = params_.mount_uncertainty;
-    const double t = m.translation_sigma_m, yaw = m.yaw_sigma_deg / kDegPerRad;
-    e.covariance = filter_->covariance() + Eigen::Vector3d(t * t, t * t, yaw * yaw).asDiagonal().toDenseMatrix();
+    const double t = m.translation_sigma_m, yaw = filter_->learns_mount_yaw() ? 0.0 : m.yaw_sigma_deg / kDegPerRad;
+    e.covariance = filter_->car_covariance() + Eigen::Vector3d(t * t, t * t, yaw * yaw).asDiagonal().toDenseMatrix();
+    if (filter_->learns_mount_yaw())
+      e.mount_yaw = MountYawEstimate{filter_->mount_yaw(), std::sqrt(filter_->mount_yaw_variance())};
     if (gps_fault_level_) e.health |= kGpsRejected;
     if (lost_.lost()) {
       e.health |= kLost;  // the bounds stay infinite

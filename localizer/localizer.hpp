@@ -82,6 +82,12 @@ enum class Stage {
 constexpr int kStageCount = 9;
 const char* stage_name(Stage s);
 
+// The LiDAR's mount yaw as the filter has learnt it (MountUncertainty::learn_yaw): the true mount's
+// against the nominal one, rad.
+struct MountYawEstimate {
+  double yaw_rad = 0, sigma_rad = 0;
+};
+
 struct LocalizerEstimate {
   int64_t stamp_ns = 0;                                      // the pose's time: the scan's last firing
   Pose2d pose;                                               // rear axle, local frame of the map
@@ -105,6 +111,8 @@ struct LocalizerEstimate {
   // estimate exceeds with at most the probability LocalizerParams::integrity states. Infinite while lost.
   double protection_lateral_m = std::numeric_limits<double>::infinity();
   double protection_longitudinal_m = std::numeric_limits<double>::infinity();
+
+  std::optional<MountYawEstimate> mount_yaw;  // when learnt
 
   bool ok() const { return health == 0; }
   bool lost() const { return (health & kLost) != 0; }
@@ -257,6 +265,8 @@ class Localizer {
     Pose2d odometry;
   };
   PoseBelief carried(const PoseBelief& belief) const;
+  // The filter's parameters, with the mount yaw's prior when it is learnt.
+  PoseFilterParams filter_params() const;
   std::optional<PoseBelief> trusted_, last_fix_;
   bool lost_by_gps_ = false;                      // the GPS was among the disagreements that made the filter lost
   std::optional<Eigen::Vector2d> last_gps_step_;  // the last step of the fixes from their level

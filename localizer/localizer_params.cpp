@@ -344,6 +344,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   YamlMap(y, top["mount_uncertainty"], "mount_uncertainty")
       .number("yaw_sigma_deg", p.mount_uncertainty.yaw_sigma_deg, 0.0, 90.0)
       .number("translation_sigma_m", p.mount_uncertainty.translation_sigma_m, 0.0, 10.0)
+      .boolean("learn_yaw", p.mount_uncertainty.learn_yaw)
       .done();
   YamlMap(y, top["lost"], "lost")
       .number("window_s", p.lost.window_s, 0.01, 100.0)

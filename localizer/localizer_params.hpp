@@ -60,6 +60,10 @@ struct HealthParams {
 struct MountUncertainty {
   double yaw_sigma_deg = 0.1;
   double translation_sigma_m = 0.003;
+  // The mount yaw as a state of the filter (pose_filter.hpp), learnt on the road from the map matches
+  // and CAN, with yaw_sigma_deg as its prior; the reported covariance then carries the state's doubt
+  // of it instead of the consider term.
+  bool learn_yaw = false;
 };
 
 struct GpsNoise {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -51,6 +52,7 @@ PoseFilter::PoseFilter(const Pose2d& initial, const Eigen::Matrix3d& covariance,
     : params_(params) {
   x_.head<3>() = Eigen::Vector3d(initial.x, initial.y, initial.yaw);
   P_.topLeftCorner<3, 3>() = covariance;
+  start_mount_yaw();
 }
 
 PoseFilter PoseFilter::from_gps_fix(const Eigen::Vector3d& z, const GpsErrorModel& gps,
@@ -58,79 +60,137 @@ PoseFilter PoseFilter::from_gps_fix(const Eigen::Vector3d& z, const GpsErrorMode
   const Eigen::Matrix3d B = gps.bias_variance.asDiagonal();
   PoseFilter f({z.x(), z.y(), wrap_angle(z.z())}, B + Eigen::Matrix3d(gps.white_variance.asDiagonal()), params);
   f.gps_ = gps;
-  f.P_.bottomRightCorner<3, 3>() = B;
-  f.P_.topRightCorner<3, 3>() = -B;  // pose = z - bias - white
-  f.P_.bottomLeftCorner<3, 3>() = -B;
+  f.P_.block<3, 3>(kBias, kBias) = B;
+  f.P_.block<3, 3>(0, kBias) = -B;  // pose = z - bias - white
+  f.P_.block<3, 3>(kBias, 0) = -B;
   return f;
 }
 
+void PoseFilter::start_mount_yaw() {
+  // The heading was given as the car's; the matching heading is that plus the mount yaw (estimate 0).
+  const double v = params_.mount_yaw_sigma_rad * params_.mount_yaw_sigma_rad;
+  if (v == 0) return;
+  P_(2, 2) += v;
+  P_(2, kMount) = P_(kMount, 2) = v;
+  P_(kMount, kMount) = v;
+}
+
 void PoseFilter::start_bias(const GpsErrorModel& gps) {
-  x_.tail<3>().setZero();
-  P_.bottomRightCorner<3, 3>() = gps.bias_variance.asDiagonal();
-  P_.topRightCorner<3, 3>().setZero();
-  P_.bottomLeftCorner<3, 3>().setZero();
+  x_.segment<3>(kBias).setZero();
+  P_.block<3, 3>(kBias, kBias) = gps.bias_variance.asDiagonal();
+  P_.block<3, kStates>(kBias, 0).leftCols<3>().setZero();
+  P_.block<kStates, 3>(0, kBias).topRows<3>().setZero();
+  P_.block<1, 3>(kMount, kBias).setZero();
+  P_.block<3, 1>(kBias, kMount).setZero();
+}
+
+Eigen::Matrix<double, 3, PoseFilter::kStates> PoseFilter::car_from_state() {
+  Eigen::Matrix<double, 3, kStates> A = Eigen::Matrix<double, 3, kStates>::Zero();
+  A.leftCols<3>().setIdentity();
+  A(2, kMount) = -1;
+  return A;
+}
+
+Eigen::Matrix3d PoseFilter::car_covariance() const {
+  if (!learns_mount_yaw()) return covariance();
+  const Eigen::Matrix<double, 3, kStates> A = car_from_state();
+  return A * P_ * A.transpose();
 }
 
 void PoseFilter::reset_pose(const Pose2d& pose, const Eigen::Matrix3d& covariance, const UnplacedAxes& unplaced) {
+  if (learns_mount_yaw())
+    reset_states<kStates>(covariance, unplaced);
+  else
+    reset_states<kMount>(covariance, unplaced);
+  x_.head<3>() = Eigen::Vector3d(pose.x, pose.y, pose.yaw);
+}
+
+template <int M>
+void PoseFilter::reset_states(const Eigen::Matrix3d& covariance, const UnplacedAxes& unplaced) {
+  using MatrixM = Eigen::Matrix<double, M, M>;
   // In a frame whose first axis is `along` (any, without it), for the pose and the bias alike.
   const Eigen::Vector2d u = unplaced.along.value_or(Eigen::Vector2d::UnitX()).normalized();
   Eigen::Matrix3d to_frame = Eigen::Matrix3d::Identity();
   to_frame.topLeftCorner<2, 2>() << u.x(), u.y(), -u.y(), u.x();
-  Matrix6d T = Matrix6d::Zero();
-  T.topLeftCorner<3, 3>() = to_frame;
-  T.bottomRightCorner<3, 3>() = to_frame;
-  const Matrix6d old = T * P_ * T.transpose();
-  Matrix6d P = Matrix6d::Zero();
-  P.topLeftCorner<3, 3>() = to_frame * covariance * to_frame.transpose();
-  if (gps_) P.bottomRightCorner<3, 3>() = to_frame * gps_->bias_variance.asDiagonal() * to_frame.transpose();
-  // Each unplaced axis with its bias (along: 0 and 3; heading: 2 and 5); the search's covariance says
-  // how the axes go together.
-  auto keep = [&](int axis) {
-    for (int i : {axis, axis + 3})
-      for (int j : {axis, axis + 3}) P(i, j) = old(i, j);
-  };
-  if (unplaced.along) keep(0);
-  if (unplaced.heading) keep(2);
-  P_ = T.transpose() * P * T;
-  x_.head<3>() = Eigen::Vector3d(pose.x, pose.y, pose.yaw);
+  MatrixM T = MatrixM::Identity();
+  T.template topLeftCorner<3, 3>() = to_frame;
+  T.template block<3, 3>(kBias, kBias) = to_frame;
+  const MatrixM old = T * P_.topLeftCorner<M, M>() * T.transpose();
+  MatrixM P = MatrixM::Zero();
+  P.template topLeftCorner<3, 3>() = to_frame * covariance * to_frame.transpose();
+  if (gps_) P.template block<3, 3>(kBias, kBias) = to_frame * gps_->bias_variance.asDiagonal() * to_frame.transpose();
+  // Each unplaced axis with its bias (along: 0 and 3; heading: 2 and 5), and the mount yaw, which no
+  // search places; the search's covariance says how the axes go together.
+  std::vector<int> kept;
+  if (M > kMount) kept.push_back(kMount);
+  if (unplaced.along) kept.insert(kept.end(), {0, kBias});
+  if (unplaced.heading) kept.insert(kept.end(), {2, kBias + 2});
+  for (int i : kept)
+    for (int j : kept) P(i, j) = old(i, j);
+  P_.topLeftCorner<M, M>() = T.transpose() * P * T;
 }
 
 void PoseFilter::predict(const Pose2d& predicted, double distance, double dt) {
-  // Jacobian of moving by the odometry increment: a displacement (dx, dy) in the body frame rotates with psi.
+  // Jacobian of moving by the odometry increment: a displacement (dx, dy) in the body frame rotates with
+  // the car's heading, psi_m - mount yaw.
   const double dpx = predicted.x - x_(0), dpy = predicted.y - x_(1);
-  Matrix6d F = Matrix6d::Identity();
+  Matrix F = Matrix::Identity();
   F(0, 2) = -dpy;
   F(1, 2) = dpx;
-  x_.head<3>() = Eigen::Vector3d(predicted.x, predicted.y, predicted.yaw);
+  F(0, kMount) = dpy;
+  F(1, kMount) = -dpx;
+  x_.head<3>() = Eigen::Vector3d(predicted.x, predicted.y, wrap_angle(predicted.yaw + x_(kMount)));
   auto sq = [](double v) { return v * v; };
   const double q_pos = sq(params_.position_per_sqrt_m) * distance + sq(params_.position_per_sqrt_s) * dt;
   const double q_yaw = sq(params_.yaw_per_sqrt_m) * distance;
-  Vector6d q = Vector6d::Zero();
+  Vector q = Vector::Zero();
   q.head<3>() = Eigen::Vector3d(q_pos, q_pos, q_yaw);
   if (gps_) {
     // The exact discretisation of the Gauss-Markov bias: it decays by phi and its stationary variance
     // is kept by a fresh (1 - phi^2) of it.
     for (int i = 0; i < 3; ++i) {
       const double phi = std::exp(-std::max(0.0, dt) / gps_->tau_s(i));
-      x_(3 + i) *= phi;
-      F(3 + i, 3 + i) = phi;
-      q(3 + i) = gps_->bias_variance(i) * (1 - phi * phi);
+      x_(kBias + i) *= phi;
+      F(kBias + i, kBias + i) = phi;
+      q(kBias + i) = gps_->bias_variance(i) * (1 - phi * phi);
     }
   }
-  P_ = F * P_ * F.transpose();
-  P_.diagonal() += q;
+  if (learns_mount_yaw())
+    propagate<kStates>(F, q);
+  else
+    propagate<kMount>(F, q);
+}
+
+template <int M>
+void PoseFilter::propagate(const Matrix& F, const Vector& q) {
+  const Eigen::Matrix<double, M, M> f = F.topLeftCorner<M, M>();
+  Eigen::Matrix<double, M, M> P = P_.topLeftCorner<M, M>();
+  P = f * P * f.transpose();
+  P.diagonal() += q.head<M>();
+  P_.topLeftCorner<M, M>() = P;
 }
 
 template <int N>
 void PoseFilter::update(const Eigen::Matrix<double, N, 1>& innovation, const Eigen::Matrix<double, N, N>& R,
-                        const Eigen::Matrix<double, N, 6>& H) {
-  const Eigen::Matrix<double, N, N> S = H * P_ * H.transpose() + R;
-  const Eigen::Matrix<double, 6, N> K = P_ * H.transpose() * S.inverse();
-  x_ += K * innovation;
+                        const Eigen::Matrix<double, N, kStates>& H) {
+  if (learns_mount_yaw())
+    correct<kStates, N>(innovation, R, H);
+  else
+    correct<kMount, N>(innovation, R, H.template leftCols<kMount>());
+}
+
+template <int M, int N>
+void PoseFilter::correct(const Eigen::Matrix<double, N, 1>& innovation, const Eigen::Matrix<double, N, N>& R,
+                         const Eigen::Matrix<double, N, M>& H) {
+  Eigen::Matrix<double, M, M> P = P_.topLeftCorner<M, M>();
+  const Eigen::Matrix<double, N, N> S = H * P * H.transpose() + R;
+  const Eigen::Matrix<double, M, N> K = P * H.transpose() * S.inverse();
+  x_.head<M>() += K * innovation;
   x_(2) = wrap_angle(x_(2));
   // Joseph form: stays symmetric and positive definite whatever the rounding.
-  const Matrix6d I_KH = Matrix6d::Identity() - K * H;
-  P_ = I_KH * P_ * I_KH.transpose() + K * R * K.transpose();
+  const Eigen::Matrix<double, M, M> I_KH = Eigen::Matrix<double, M, M>::Identity() - K * H;
+  P = I_KH * P * I_KH.transpose() + K * R * K.transpose();
+  P_.topLeftCorner<M, M>() = P;
 }
 
 template <int N>
@@ -138,30 +198,36 @@ void PoseFilter::update_pose(const Eigen::Matrix<double, N, 1>& z, const Eigen::
                              const Eigen::Matrix<double, N, 3>& H) {
   Eigen::Matrix<double, N, 1> innovation = z - H * x_.head<3>();
   if constexpr (N == 3) innovation(2) = wrap_angle(innovation(2));  // angles as angles
-  Eigen::Matrix<double, N, 6> H6 = Eigen::Matrix<double, N, 6>::Zero();
-  H6.template leftCols<3>() = H;
-  update<N>(innovation, R, H6);
+  Eigen::Matrix<double, N, kStates> H7 = Eigen::Matrix<double, N, kStates>::Zero();
+  H7.template leftCols<3>() = H;  // a match measures the matching pose: the mount yaw is in psi_m already
+  update<N>(innovation, R, H7);
 }
 
+// A fix measures the car (psi_m - mount yaw) plus the bias.
 Eigen::Vector3d PoseFilter::gps_innovation(const Eigen::Vector3d& z) const {
-  Eigen::Vector3d innovation = z - x_.head<3>() - x_.tail<3>();
+  const Pose2d car = car_pose();
+  Eigen::Vector3d innovation = z - Eigen::Vector3d(car.x, car.y, car.yaw) - x_.segment<3>(kBias);
   innovation(2) = wrap_angle(innovation(2));
   return innovation;
 }
 
 Eigen::Matrix3d PoseFilter::gps_innovation_covariance(const GpsErrorModel& gps) const {
-  // H = [I I]; an unstarted bias is the model's stationary one.
+  // H = [A I] with A the car's rows; an unstarted bias is the model's stationary one.
+  const Eigen::Matrix<double, 3, kStates> A = car_from_state();
+  const Eigen::Matrix3d car = car_covariance();
   const Eigen::Matrix3d B =
-      gps_ ? Eigen::Matrix3d(P_.bottomRightCorner<3, 3>()) : Eigen::Matrix3d(gps.bias_variance.asDiagonal());
-  const Eigen::Matrix3d cross = gps_ ? Eigen::Matrix3d(P_.topRightCorner<3, 3>()) : Eigen::Matrix3d::Zero();
-  return P_.topLeftCorner<3, 3>() + B + cross + cross.transpose() + Eigen::Matrix3d(gps.white_variance.asDiagonal());
+      gps_ ? Eigen::Matrix3d(P_.block<3, 3>(kBias, kBias)) : Eigen::Matrix3d(gps.bias_variance.asDiagonal());
+  const Eigen::Matrix3d cross = !gps_                ? Eigen::Matrix3d::Zero()
+                                : learns_mount_yaw() ? Eigen::Matrix3d(A * P_.block<kStates, 3>(0, kBias))
+                                                     : Eigen::Matrix3d(P_.block<3, 3>(0, kBias));
+  return car + B + cross + cross.transpose() + Eigen::Matrix3d(gps.white_variance.asDiagonal());
 }
 
 void PoseFilter::update_gps(const Eigen::Vector3d& z, const GpsErrorModel& gps) {
   if (!gps_) start_bias(gps);
   gps_ = gps;  // the receiver's word on its stationary error may change from fix to fix
-  Eigen::Matrix<double, 3, 6> H;
-  H << Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity();
+  Eigen::Matrix<double, 3, kStates> H;
+  H << car_from_state().leftCols<kBias>(), Eigen::Matrix3d::Identity(), car_from_state().rightCols<1>();
   update<3>(gps_innovation(z), gps.white_variance.asDiagonal().toDenseMatrix(), H);
 }
 

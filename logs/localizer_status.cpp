@@ -1,6 +1,7 @@
 #include "logs/localizer_status.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <string_view>
@@ -47,6 +48,14 @@ class Values {
     if (ec != std::errc() || end != v.data() + v.size() || out < 0) fail(key, v, "a non-negative number or inf");
     return out;
   }
+  bool has(const std::string& key) const { return values_.count(key) != 0; }
+  double finite(const std::string& key) const {
+    const std::string& v = text(key);
+    double out = 0;
+    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
+    if (ec != std::errc() || end != v.data() + v.size() || !std::isfinite(out)) fail(key, v, "a finite number");
+    return out;
+  }
   uint32_t flags(const std::string& key) const {
     const std::string& v = text(key);
     const std::string_view prefix = "0x";
@@ -78,6 +87,10 @@ ros2::Bytes encode_localizer_status(const LocalizerStatus& s) {
               {"protection_lateral_m", round_trip_number(s.protection_lateral_m)},
               {"protection_longitudinal_m", round_trip_number(s.protection_longitudinal_m)},
               {"wide_search", word(s.wide_search)}};
+  if (s.mount_yaw_deg && s.mount_yaw_sigma_deg) {
+    d.values.emplace_back("mount_yaw_deg", round_trip_number(*s.mount_yaw_deg));
+    d.values.emplace_back("mount_yaw_sigma_deg", round_trip_number(*s.mount_yaw_sigma_deg));
+  }
   return ros2::encode_diagnostic_array({s.stamp_ns, log_topics::estimate_frame, {d}});
 }
 
@@ -97,6 +110,10 @@ std::optional<LocalizerStatus> decode_localizer_status(ros2::View cdr, const std
     s.protection_lateral_m = v.bound("protection_lateral_m");
     s.protection_longitudinal_m = v.bound("protection_longitudinal_m");
     s.wide_search = v.boolean("wide_search");
+    if (v.has("mount_yaw_deg") || v.has("mount_yaw_sigma_deg")) {
+      s.mount_yaw_deg = v.finite("mount_yaw_deg");
+      s.mount_yaw_sigma_deg = v.finite("mount_yaw_sigma_deg");
+    }
     return s;
   }
   return std::nullopt;

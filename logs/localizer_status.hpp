@@ -10,6 +10,8 @@
 //                protection_lateral_m       the per-scan protection bounds (m, estimate's vehicle frame),
 //                protection_longitudinal_m  shortest round-trip decimal, "inf" while lost
 //                wide_search                true | false: the scan ran (a share of) a relocalization
+//                mount_yaw_deg              only from a localizer that learns the LiDAR's mount yaw: its
+//                mount_yaw_sigma_deg        estimate against the nominal mount and its 1 sigma (deg)
 // header.stamp is the estimate's: the stamp of its /localizer/odometry, which is published only once
 // the localizer has a pose, while the status goes out for every scan. header.frame_id is
 // base_link_estimate, the frame the bounds are in.
@@ -33,6 +35,7 @@ struct LocalizerStatus {
   double protection_lateral_m = std::numeric_limits<double>::infinity();
   double protection_longitudinal_m = std::numeric_limits<double>::infinity();
   bool wide_search = false;
+  std::optional<double> mount_yaw_deg, mount_yaw_sigma_deg;  // both or neither
 };
 
 ros2::Bytes encode_localizer_status(const LocalizerStatus& status);

@@ -60,6 +60,10 @@ LocalizerStatus localizer_status(const LocalizerEstimate& e) {
   s.protection_lateral_m = e.protection_lateral_m;
   s.protection_longitudinal_m = e.protection_longitudinal_m;
   s.wide_search = e.wide_search;
+  if (e.mount_yaw) {
+    s.mount_yaw_deg = e.mount_yaw->yaw_rad * kDegPerRad;
+    s.mount_yaw_sigma_deg = e.mount_yaw->sigma_rad * kDegPerRad;
+  }
   return s;
 }
 

@@ -65,6 +65,8 @@ void apply_statuses(std::vector<EstimateRecord>& estimates, const std::map<int64
     e.lost = s->second.lost;
     e.protection_lateral_m = s->second.protection_lateral_m;
     e.protection_longitudinal_m = s->second.protection_longitudinal_m;
+    if (s->second.mount_yaw_deg) e.mount_yaw_deg = *s->second.mount_yaw_deg;
+    if (s->second.mount_yaw_sigma_deg) e.mount_yaw_sigma_deg = *s->second.mount_yaw_sigma_deg;
   }
 }
 

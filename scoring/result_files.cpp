@@ -197,6 +197,13 @@ std::string metrics_json(const Metrics& m) {
         {"misleading_awaiting_alert", m.integrity.misleading_awaiting_alert},
         {"availability", finite_or_null(m.integrity.availability)}}},
       {"recovery", recovery_json(m.recovery)},
+      {"mount_yaw", m.mount_yaw ? json{{"drawn_deg", m.mount_yaw->drawn_deg},
+                                       {"learnt_deg", m.mount_yaw->learnt_deg},
+                                       {"sigma_deg", m.mount_yaw->sigma_deg},
+                                       {"error_deg", m.mount_yaw->error_deg},
+                                       {"tolerance_deg", m.mount_yaw->tolerance_deg},
+                                       {"settled_s", optional_or_null(m.mount_yaw->settled_s)}}
+                                : json(nullptr)},
       {"thresholds",
        {{"against", m.thresholds.against_reference ? "reference" : "truth"},
         {"lateral_rmse_m", optional_or_null(m.thresholds.lateral_rmse_m)},
@@ -288,6 +295,16 @@ std::string integrity_lines(const Metrics& m, const std::string& label) {
   const std::string who = label.empty() ? "" : label + ": ";
   std::string text = "nees       " + who + consistency_text(m) + "\nintegrity  " + who + integrity_text(m) + "\n";
   for (const EventRecovery& r : m.recovery) text += "recovery   " + who + recovery_text(r) + "\n";
+  if (const auto& y = m.mount_yaw) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "mount yaw  %slearnt %.3f deg, sigma %.3f, against the drawn %.3f deg: off by %.3f; ", who.c_str(),
+                  y->learnt_deg, y->sigma_deg, y->drawn_deg, y->error_deg);
+    text += line +
+            (y->settled_s ? "within " + cell(y->tolerance_deg, "%.2f deg") + " from " + cell(*y->settled_s, "%.1f s")
+                          : "not within " + cell(y->tolerance_deg, "%.2f deg") + " at the end") +
+            "\n";
+  }
   return text;
 }
 

@@ -507,4 +507,24 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
   return run;
 }
 
+std::optional<MountYawMetrics> mount_yaw_metrics(const std::vector<EstimateRecord>& estimates, double drawn_deg,
+                                                 double tolerance_deg) {
+  std::optional<MountYawMetrics> m;
+  int64_t first_ns = 0, settled_ns = 0;
+  bool within = false;
+  for (const EstimateRecord& e : estimates) {
+    if (!std::isfinite(e.mount_yaw_deg)) continue;
+    if (!m) m = MountYawMetrics{drawn_deg, 0, 0, 0, std::nullopt, tolerance_deg}, first_ns = e.stamp_ns;
+    m->learnt_deg = e.mount_yaw_deg;
+    m->sigma_deg = e.mount_yaw_sigma_deg;
+    const bool now = std::abs(e.mount_yaw_deg - drawn_deg) <= tolerance_deg;
+    if (now && !within) settled_ns = e.stamp_ns;
+    within = now;
+  }
+  if (!m) return m;
+  m->error_deg = m->learnt_deg - drawn_deg;
+  if (within) m->settled_s = double(settled_ns - first_ns) / double(kNsPerS);
+  return m;
+}
+
 }  // namespace lidarloop

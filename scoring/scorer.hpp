@@ -76,6 +76,10 @@ struct EstimateRecord {
   // within at its stated probability; NaN when not given (an estimate read from a file without them).
   double protection_lateral_m = std::numeric_limits<double>::quiet_NaN();
   double protection_longitudinal_m = std::numeric_limits<double>::quiet_NaN();
+  // The LiDAR's mount yaw against the nominal mount as the localizer has learnt it, and its 1 sigma
+  // (deg); NaN from a localizer that does not learn it.
+  double mount_yaw_deg = std::numeric_limits<double>::quiet_NaN();
+  double mount_yaw_sigma_deg = std::numeric_limits<double>::quiet_NaN();
 };
 
 // A moment a localizer must recover from: the start of the run, a GPS jump, a kidnap (the scenario's
@@ -164,6 +168,18 @@ struct ReferenceAccuracy {
   double error_heading_rms_deg = std::numeric_limits<double>::quiet_NaN();
 };
 
+// What a localizer that learns the LiDAR's mount yaw (EstimateRecord::mount_yaw_deg) made of it,
+// against the run's draw.
+struct MountYawMetrics {
+  double drawn_deg = 0;
+  double learnt_deg = 0, sigma_deg = 0;  // the last estimate's
+  double error_deg = 0;                  // learnt - drawn
+  // The time from the first estimate after which every estimate's learnt yaw lies within tolerance_deg
+  // of the drawn one; unset if the last one does not.
+  std::optional<double> settled_s;
+  double tolerance_deg = 0;
+};
+
 struct Metrics {
   std::string method, scenario;
   // The run's realism profile and the knobs the scenario set on top of it (labels, not scored).
@@ -199,7 +215,8 @@ struct Metrics {
   std::optional<ReferenceAccuracy> reference;
   Consistency consistency;
   Integrity integrity;
-  std::vector<EventRecovery> recovery;  // one per event given to score(), in time order
+  std::vector<EventRecovery> recovery;       // one per event given to score(), in time order
+  std::optional<MountYawMetrics> mount_yaw;  // from a localizer that learns it
   PassThresholds thresholds;
   bool pass = false;
   std::vector<std::string> failures;  // for people, e.g. "lateral RMSE 0.310 m > 0.200 m"
@@ -241,6 +258,10 @@ ScoredRun score(const std::vector<TruthPose>& truth, const std::vector<EstimateR
                 int64_t scan_period_ns = Hdl32eConfig{}.scan_period_ns(), const std::vector<TruthPose>& reference = {});
 
 // ---- Its parts, pure as well ----
+
+// The mount yaw a localizer learnt against the drawn one (deg); unset when no estimate carries one.
+std::optional<MountYawMetrics> mount_yaw_metrics(const std::vector<EstimateRecord>& estimates, double drawn_deg,
+                                                 double tolerance_deg);
 
 // The error of `estimate` against `truth` by the convention above; stamp_ns is left 0 for the caller
 // and the estimate's claims NaN (not given).

@@ -256,6 +256,34 @@ TEST(LocalizerStatus, RoundTripsExactlyAsADiagnosticArray) {
   EXPECT_THROW(decode_localizer_status(ros2::View(bytes.data(), bytes.size() - 3), "test"), InputError);
 }
 
+// A localizer that learns the LiDAR's mount yaw says so in two more values, which read back to the same
+// bits; one without the other, or a value that is not a finite number, is an error. Without them the
+// status is as it always was (above).
+TEST(LocalizerStatus, CarriesALearntMountYawWhenThereIsOne) {
+  LocalizerStatus s;
+  s.mount_yaw_deg = 0.1 + 0.2;
+  s.mount_yaw_sigma_deg = 1.0 / 3;
+  const ros2::Bytes bytes = encode_localizer_status(s);
+  const ros2::DiagnosticArray array = ros2::decode_diagnostic_array(bytes, "test");
+  ASSERT_EQ(array.status.size(), 1u);
+  const auto& values = array.status[0].values;
+  ASSERT_EQ(values.size(), 7u);
+  EXPECT_EQ(values[5], (std::pair<std::string, std::string>{"mount_yaw_deg", "0.30000000000000004"}));
+  EXPECT_EQ(values[6], (std::pair<std::string, std::string>{"mount_yaw_sigma_deg", "0.3333333333333333"}));
+  const std::optional<LocalizerStatus> back = decode_localizer_status(bytes, "test");
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->mount_yaw_deg, s.mount_yaw_deg);
+  EXPECT_EQ(back->mount_yaw_sigma_deg, s.mount_yaw_sigma_deg);
+  for (const std::string& value : {"nan", "inf", "0.1 deg", ""}) {
+    ros2::DiagnosticArray edited = array;
+    edited.status[0].values[5].second = value;
+    EXPECT_THROW(decode_localizer_status(ros2::encode_diagnostic_array(edited), "test"), InputError) << value;
+  }
+  ros2::DiagnosticArray half = array;
+  half.status[0].values.pop_back();
+  EXPECT_THROW(decode_localizer_status(ros2::encode_diagnostic_array(half), "test"), InputError);
+}
+
 TEST(Ros2Messages, PointCloudRoundTripsExactlyAndRejectsBadLayouts) {
   const auto run = test::make_synthetic_run(0.1, 300, 3);
   const PointCloud& cloud = run.scans.at(0);
