@@ -66,6 +66,8 @@ RecordedLog read_recorded_log(const std::string& log) {
       out.truth.push_back(ros2::decode_truth_state(message.data, context));
     else if (topic == topics::truth_curb_visibility)
       out.curb_visibility.push_back(ros2::decode_curb_visibility(message.data, context));
+    else if (topic == topics::vehicle_report)
+      out.can.push_back(ros2::decode_vehicle_report(message.data, context));
   }
   out.run = recorded_run(reader, log);
   if (out.truth.empty())

@@ -40,6 +40,7 @@ struct RecordedLog {
   RecordedRun run;
   std::vector<TruthSample> truth;               // /truth/state, in log order
   std::vector<CurbVisibility> curb_visibility;  // /truth/curb_visibility (empty in older logs)
+  std::vector<CanFrame> can;                    // /vehicle/report, in log order
 };
 // InputError naming `log` when it has no ground truth to score against.
 RecordedLog read_recorded_log(const std::string& log);

@@ -1,13 +1,20 @@
-// lidarloop info / recover / export: look into an MCAP log, repair a damaged one, convert one.
+// lidarloop info / recover / export / odometry: look into an MCAP log, repair a damaged one, convert one,
+// measure its CAN odometry's drift.
+#include <algorithm>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <map>
 
 #include "common/input_error.hpp"
+#include "common/units.hpp"
+#include "localizer/localizer_params.hpp"
 #include "logs/log_export.hpp"
 #include "logs/mcap/mcap_reader.hpp"
 #include "logs/mcap/mcap_recover.hpp"
+#include "loop/localizer_setup.hpp"
+#include "loop/odometry_drift.hpp"
 #include "loop/recorded_log.hpp"
 #include "tools/commands.hpp"
 
@@ -180,7 +187,53 @@ int run_export(const Args& args) {
   return 0;
 }
 
+int run_odometry(const Args& args) {
+  const std::string log = args.positional().at(0), lengths_text = args.text("lengths", "10,50,200");
+  const std::vector<double> lengths = parse_number_list(
+      lengths_text, size_t(std::count(lengths_text.begin(), lengths_text.end(), ',')) + 1, "--lengths");
+  for (double l : lengths)
+    if (!(l > 0)) throw InputError("--lengths: every length must be positive, got " + lengths_text);
+  const RecordedLog recorded = read_recorded_log(log);
+  if (recorded.can.empty()) throw InputError(log + ": no /vehicle/report messages (CAN) to dead-reckon");
+  // What the run's localizer knew of the car and how it integrates Eq. 19.
+  const LocalizerParams params = localizer_params_for(recorded.run.scenario);
+  const std::vector<OdometryDrift> drift =
+      odometry_drift(recorded.truth, recorded.can, params.vehicle, params.max_prediction_step_s, lengths);
+  std::printf("odometry   %s: %zu CAN frames dead-reckoned with Eq. 19 against %zu truth samples\n", log.c_str(),
+              recorded.can.size(), recorded.truth.size());
+  std::printf("%10s %10s %14s %17s %13s   %s\n", "length m", "stretches", "lateral RMS m", "longitudinal RMS m",
+              "heading deg", "per sqrt(m): lateral, longitudinal m, heading rad");
+  for (const OdometryDrift& d : drift) {
+    if (d.stretches == 0) {
+      std::printf("%10.1f %10s   (the drive is shorter)\n", d.length_m, "0");
+      continue;
+    }
+    const double root = std::sqrt(d.length_m);
+    std::printf("%10.1f %10zu %14.4f %17.4f %13.4f   %.4f, %.4f, %.5f\n", d.length_m, d.stretches, d.lateral_rms_m,
+                d.longitudinal_rms_m, d.heading_rms_rad * kDegPerRad, d.lateral_rms_m / root,
+                d.longitudinal_rms_m / root, d.heading_rms_rad / root);
+  }
+  std::printf(
+      "filter     the process noise it stands for: position %.4f m/sqrt(m) and %.3f m/sqrt(s), heading %.5f "
+      "rad/sqrt(m) (filter: in the localizer's parameters)\n",
+      params.filter.position_per_sqrt_m, params.filter.position_per_sqrt_s, params.filter.yaw_per_sqrt_m);
+  return 0;
+}
+
 }  // namespace
+
+Command odometry_command() {
+  return {{"odometry",
+           "lidarloop odometry FILE.mcap [--lengths 10,50,200]",
+           "Measure how far the CAN odometry of a recorded run drifts from its truth: the wheel speeds and\n"
+           "steering dead-reckoned with the localizer's Eq. 19 over every stretch of each length (one a metre),\n"
+           "the error at its end across and along the road and in heading, as RMS and per square root of\n"
+           "the length, beside the localizer's process noise.",
+           {{"lengths", "M,M,...", "stretch lengths in metres (default 10,50,200)"}},
+           1,
+           1},
+          run_odometry};
+}
 
 Command info_command() {
   return {{"info",

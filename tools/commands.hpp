@@ -22,6 +22,7 @@ Command map_command();
 Command info_command();
 Command recover_command();
 Command export_command();
+Command odometry_command();
 Command run_command();
 Command compare_command();
 Command replay_command();

@@ -15,7 +15,7 @@ using namespace lidarloop;
 static std::vector<Command> commands() {
   return {world_command(),   scan_command(),    validate_command(), simulate_command(), run_command(),
           compare_command(), replay_command(),  score_command(),    map_command(),      info_command(),
-          export_command(),  recover_command(), bench_command(),    sweep_command()};
+          export_command(),  recover_command(), odometry_command(), bench_command(),    sweep_command()};
 }
 
 // A command's first sentence, its lines joined: the summary's opening sentence says what the command
