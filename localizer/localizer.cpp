@@ -637,6 +637,7 @@ bool Localizer::fuse_pose(const PoseObservation& z, int& rejections, LocalizerEs
   }
   if (!doubt.isZero()) filter_->inflate(doubt);
   filter_->update_curb(Eigen::Vector3d(z.pose.x, z.pose.y, z.pose.yaw), z.covariance);  // KF2
+  e.fused_pose = MapObservation{e.stamp_ns, z.pose, in_car_axes(z.covariance, z.pose.yaw), Eigen::Vector2d::Zero()};
   // Curbs along a straight road say nothing of the position along it.
   const Eigen::Vector2d forward(std::cos(prior.yaw), std::sin(prior.yaw));
   const double along_sigma = std::sqrt(forward.dot(z.covariance.topLeftCorner<2, 2>() * forward));
@@ -796,6 +797,15 @@ void Localizer::fuse_intensity(const ApsResult& aps, const IntensityGrid& grid, 
   else
     e.health |= kIntensityAmbiguous;
   if (along || across) {
+    // What the filter believed of it, an axis not taken infinite.
+    const double infinite = std::numeric_limits<double>::infinity();
+    Eigen::Matrix3d taken = Eigen::Vector3d(0, 0, infinite).asDiagonal();
+    taken.topLeftCorner<2, 2>() = R;
+    taken = in_car_axes(taken, prior.yaw);
+    for (int axis : {0, 1})
+      if (!(axis == 0 ? along : across))
+        taken.row(axis).setZero(), taken.col(axis).setZero(), taken(axis, axis) = infinite;
+    e.fused_intensity = MapObservation{e.stamp_ns, {aps.position.x(), aps.position.y(), prior.yaw}, taken, J};
     const Eigen::Matrix2d to_vehicle = Eigen::Rotation2Dd(-prior.yaw).toRotationMatrix();
     const Eigen::Vector2d nu = to_vehicle * innovation;
     const Eigen::Vector2d prior_variance = (to_vehicle * HPH * to_vehicle.transpose()).diagonal();

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 
 #include "common/geodetic.hpp"
+#include "common/map_observation.hpp"
 #include "common/point_cloud.hpp"
 #include "common/vehicle_messages.hpp"
 #include "localizer/curb_features.hpp"
@@ -113,6 +114,8 @@ struct LocalizerEstimate {
   double protection_longitudinal_m = std::numeric_limits<double>::infinity();
 
   std::optional<MountYawEstimate> mount_yaw;  // when learnt
+  // What the filter took from the map this scan: the curbs' (or gicp's) pose, APS's position.
+  std::optional<MapObservation> fused_pose, fused_intensity;
 
   bool ok() const { return health == 0; }
   bool lost() const { return (health & kLost) != 0; }

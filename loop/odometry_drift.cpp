@@ -38,8 +38,7 @@ std::vector<OdometryDrift> odometry_drift(const std::vector<TruthSample>& truth,
     speed = m.speed, steer = m.steer, last_ns = f.stamp_ns;
     if (f.stamp_ns < true_poses.front().stamp_ns || f.stamp_ns > true_poses.back().stamp_ns) continue;
     const Pose2d at = truth_at(true_poses, f.stamp_ns);
-    if (!samples.empty())
-      distance += std::hypot(at.x - samples.back().truth.x, at.y - samples.back().truth.y);
+    if (!samples.empty()) distance += std::hypot(at.x - samples.back().truth.x, at.y - samples.back().truth.y);
     samples.push_back({odometry, at, distance});
   }
 

@@ -9,6 +9,7 @@
 #include "localizer/driving_corridor.hpp"
 #include "logs/ros2_messages.hpp"
 #include "loop/fault_events.hpp"
+#include "loop/localizer_setup.hpp"
 #include "scoring/birdseye.hpp"
 #include "scoring/error_plots.hpp"
 #include "scoring/reference_trajectory.hpp"
@@ -64,7 +65,9 @@ std::vector<EstimateRecord> estimate_records(const std::vector<LocalizerEstimate
                    e.protection_lateral_m,
                    e.protection_longitudinal_m,
                    e.mount_yaw ? e.mount_yaw->yaw_rad * kDegPerRad : std::numeric_limits<double>::quiet_NaN(),
-                   e.mount_yaw ? e.mount_yaw->sigma_rad * kDegPerRad : std::numeric_limits<double>::quiet_NaN()});
+                   e.mount_yaw ? e.mount_yaw->sigma_rad * kDegPerRad : std::numeric_limits<double>::quiet_NaN(),
+                   e.fused_pose,
+                   e.fused_intensity});
   }
   return out;
 }
@@ -97,6 +100,22 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
   constexpr double kMountYawToleranceDeg = 0.03;
   scored.metrics.mount_yaw =
       mount_yaw_metrics(estimates, scored.metrics.mount_error_rpy_deg.z(), kMountYawToleranceDeg);
+  std::vector<MapObservation> poses, intensities;
+  for (const EstimateRecord& e : estimates) {
+    if (e.pose_observation) poses.push_back(*e.pose_observation);
+    if (e.intensity_observation) intensities.push_back(*e.intensity_observation);
+  }
+  // An axis the curbs do not constrain (a straight's along, sigma of 100 m) says nothing to check: left
+  // out beyond the inlier distance, beyond which the curb matcher takes no information either.
+  if (!poses.empty() || !intensities.empty()) {
+    const double informative_sigma = localizer_params_for(scenario).curb_noise.inlier_distance_m;
+    if (!poses.empty())
+      scored.metrics.pose_observations =
+          observation_consistency(truth, poses, mount.lidar_rpy_rad.z(), informative_sigma);
+    if (!intensities.empty())
+      scored.metrics.intensity_observations =
+          observation_consistency(truth, intensities, mount.lidar_rpy_rad.z(), informative_sigma);
+  }
 
   prepare_output_dir(dir);
   write_metrics_json(dir + "/metrics.json", scored.metrics);

@@ -147,6 +147,17 @@ void write_text_file(const std::string& path, const std::string& text) {
   if (!out) throw InputError(path + ": cannot write");
 }
 
+json observations_json(const std::optional<ObservationConsistency>& o) {
+  if (!o) return nullptr;
+  const char* axes[] = {"along", "across", "heading"};
+  json out;
+  for (int axis = 0; axis < 3; ++axis)
+    out[axes[axis]] = {{"observations", o->counts(axis)},
+                       {"mean_nees", finite_or_null(o->mean_nees(axis))},
+                       {"rms_error", finite_or_null(o->rms_error(axis))}};
+  return out;
+}
+
 std::string metrics_json(const Metrics& m) {
   const json doc = {
       {"method", m.method},
@@ -197,6 +208,8 @@ std::string metrics_json(const Metrics& m) {
         {"misleading_awaiting_alert", m.integrity.misleading_awaiting_alert},
         {"availability", finite_or_null(m.integrity.availability)}}},
       {"recovery", recovery_json(m.recovery)},
+      {"map_observations",
+       {{"pose", observations_json(m.pose_observations)}, {"intensity", observations_json(m.intensity_observations)}}},
       {"mount_yaw", m.mount_yaw ? json{{"drawn_deg", m.mount_yaw->drawn_deg},
                                        {"learnt_deg", m.mount_yaw->learnt_deg},
                                        {"sigma_deg", m.mount_yaw->sigma_deg},
@@ -295,6 +308,17 @@ std::string integrity_lines(const Metrics& m, const std::string& label) {
   const std::string who = label.empty() ? "" : label + ": ";
   std::string text = "nees       " + who + consistency_text(m) + "\nintegrity  " + who + integrity_text(m) + "\n";
   for (const EventRecovery& r : m.recovery) text += "recovery   " + who + recovery_text(r) + "\n";
+  for (const auto& [name, o] :
+       {std::pair{"curbs", &m.pose_observations}, std::pair{"intensity", &m.intensity_observations}}) {
+    if (!*o) continue;
+    const ObservationConsistency& c = **o;
+    text +=
+        std::string("observed   ") + who + name + ": mean NEES along " + cell(c.mean_nees(0), "%.2f") + " (" +
+        std::to_string(c.counts(0)) + "), across " + cell(c.mean_nees(1), "%.2f") + " (" + std::to_string(c.counts(1)) +
+        ")" +
+        (c.counts(2) ? ", heading " + cell(c.mean_nees(2), "%.2f") + " (" + std::to_string(c.counts(2)) + ")" : "") +
+        " of the observations the filter took, each against the truth\n";
+  }
   if (const auto& y = m.mount_yaw) {
     char line[256];
     std::snprintf(line, sizeof line,

@@ -46,7 +46,9 @@
 #include <Eigen/Core>
 
 #include "common/curb_visibility.hpp"
+#include "common/map_observation.hpp"
 #include "common/vehicle_messages.hpp"
+#include "scoring/observation_consistency.hpp"
 #include "sim/path.hpp"
 #include "sim/scenario.hpp"
 
@@ -80,6 +82,8 @@ struct EstimateRecord {
   // (deg); NaN from a localizer that does not learn it.
   double mount_yaw_deg = std::numeric_limits<double>::quiet_NaN();
   double mount_yaw_sigma_deg = std::numeric_limits<double>::quiet_NaN();
+  // The map observations the localizer's filter took for this estimate, when it says (a built-in one).
+  std::optional<MapObservation> pose_observation, intensity_observation;
 };
 
 // A moment a localizer must recover from: the start of the run, a GPS jump, a kidnap (the scenario's
@@ -217,6 +221,9 @@ struct Metrics {
   Integrity integrity;
   std::vector<EventRecovery> recovery;       // one per event given to score(), in time order
   std::optional<MountYawMetrics> mount_yaw;  // from a localizer that learns it
+  // Its map observations against the truth (scoring/observation_consistency.hpp), when it gives them:
+  // the curbs' or the point cloud's pose, and APS's position.
+  std::optional<ObservationConsistency> pose_observations, intensity_observations;
   PassThresholds thresholds;
   bool pass = false;
   std::vector<std::string> failures;  // for people, e.g. "lateral RMSE 0.310 m > 0.200 m"

@@ -40,7 +40,8 @@ TEST(OdometryDrift, AScaleErrorShowsAlongTheRoadInProportionToTheLength) {
     EXPECT_LT(d.lateral_rms_m, 1e-9) << d.length_m;
   }
   const StraightDrive fast = straight_drive(1.01);
-  const std::vector<OdometryDrift> drift = odometry_drift(fast.truth, fast.can, VehicleModelParams{}, 0.01, {10, 100, 1000});
+  const std::vector<OdometryDrift> drift =
+      odometry_drift(fast.truth, fast.can, VehicleModelParams{}, 0.01, {10, 100, 1000});
   ASSERT_EQ(drift.size(), 3u);
   EXPECT_NEAR(drift[0].longitudinal_rms_m, 0.1, 0.002);  // a stretch ends at the first sample 10 m on
   EXPECT_NEAR(drift[1].longitudinal_rms_m, 1.0, 0.002);
