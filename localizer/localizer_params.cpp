@@ -299,6 +299,7 @@ void read_localizer_params(const YamlReader& y, const YAML::Node& node, Localize
   YamlMap(y, top["filter"], "filter")
       .number("position_per_sqrt_m", p.filter.position_per_sqrt_m, 0.0, 10.0)
       .number("yaw_per_sqrt_m", p.filter.yaw_per_sqrt_m, 0.0, 1.0)
+      .number("yaw_per_sqrt_rad", p.filter.yaw_per_sqrt_rad, 0.0, 1.0)
       .number("position_per_sqrt_s", p.filter.position_per_sqrt_s, 0.0, 10.0)
       .done();
   YamlMap(y, top["curb_noise"], "curb_noise")

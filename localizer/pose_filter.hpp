@@ -68,6 +68,10 @@ struct PoseFilterParams {
   // rad / sqrt(m): steering offset, Eq. 19's simplifications. Set for a consistent heading over the scenario
   // suite (one value for all of it): 0.002 claimed twice the heading error there.
   double yaw_per_sqrt_m = 0.001;
+  // rad / sqrt(rad) of heading turned: the yaw rate's scale error. Eq. 19 turns the car by the wheels'
+  // speed, so a tyre radius off by 0.5 % (sim/can_model.hpp) or a steering ratio off by as much turns it
+  // 0.5 % too far or short: 0.45 deg in a 90 deg bend, however long the bend. 0: none.
+  double yaw_per_sqrt_rad = 0;
   // m / sqrt(s): what odometry cannot see; also what lets the low-cost GPS's slowly wandering bias through,
   // so that with GPS alone the estimate follows the GPS within seconds rather than lagging it.
   double position_per_sqrt_s = 0.2;

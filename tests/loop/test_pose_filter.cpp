@@ -235,6 +235,21 @@ TEST(PoseFilter, TheMountYawIsLearntFromTheDriftItWouldCauseAcrossTheRoad) {
   EXPECT_NEAR(nominal.car_heading_error_at_20s, mount, 0.03 * deg);  // the matches' heading, mount and all
 }
 
+// The yaw rate's scale error: a quarter turn adds k^2 pi/2 to the heading's variance beyond what the
+// same distance driven straight adds, in whatever steps it is taken.
+TEST(PoseFilter, TheHeadingsDoubtGrowsWithTheAngleTurned) {
+  PoseFilterParams params;
+  params.yaw_per_sqrt_rad = 0.0063;
+  PoseFilter straight({0, 0, 0}, Eigen::Matrix3d::Identity() * 1e-6, params);
+  PoseFilter bend({0, 0, 0}, Eigen::Matrix3d::Identity() * 1e-6, params);
+  for (int k = 0; k < 100; ++k) {
+    straight.predict(straight.car_pose().compose({0.2, 0, 0}), 0.2, 0.02);
+    bend.predict(bend.car_pose().compose({0.2, 0, M_PI / 200}), 0.2, 0.02);
+  }
+  EXPECT_NEAR(bend.pose().yaw, M_PI / 2, 1e-12);
+  EXPECT_NEAR(bend.covariance()(2, 2) - straight.covariance()(2, 2), 0.0063 * 0.0063 * M_PI / 2, 1e-12);
+}
+
 TEST(PoseFilter, AConfidentCurbObservationPullsThePoseToIt) {
   PoseFilter filter({10, 0, 0.1}, Eigen::Vector3d(4, 4, 0.01).asDiagonal());
   filter.update_curb({11, -0.5, 0.12}, Eigen::Vector3d(0.01, 0.01, 1e-4).asDiagonal());
