@@ -306,7 +306,7 @@ void Localizer::on_gps(const GpsFix& fix) {
     // The change since the previous fix less the car's motion by odometry (turned into the local frame
     // by the filter's heading): two fixes' white noise.
     const Pose2d moved = relative(previous->odometry, odometry_);
-    const Eigen::Vector2d travelled = Eigen::Rotation2Dd(filter_->pose().yaw) * Eigen::Vector2d(moved.x, moved.y);
+    const Eigen::Vector2d travelled = Eigen::Rotation2Dd(filter_->car_pose().yaw) * Eigen::Vector2d(moved.x, moved.y);
     gps_jitter_.add(Eigen::Vector3d(z.x() - previous->z.x() - travelled.x(), z.y() - previous->z.y() - travelled.y(),
                                     wrap_angle(z.z() - previous->z.z() - moved.yaw)));
   }
@@ -972,14 +972,16 @@ void Localizer::move_to(const Relocation& found) {
   judge_gps_jump(found.pose);
 }
 
-// Moved by the odometry since, with odometry's per-metre doubt over that distance (the filter's random
-// walks per metre; not its per-second term, nor the heading's doubt turned into position by the drive).
+// Moved by the odometry since, with odometry's doubt over that distance and turn (the filter's random
+// walks per metre and per radian turned; not its per-second term, nor the heading's doubt turned into
+// position by the drive).
 Localizer::PoseBelief Localizer::carried(const PoseBelief& belief) const {
   const Pose2d moved = relative(belief.odometry, odometry_);
   const double distance = std::hypot(moved.x, moved.y);
   const PoseFilterParams& q = params_.filter;
   const double position = q.position_per_sqrt_m * q.position_per_sqrt_m * distance;
-  const double yaw = q.yaw_per_sqrt_m * q.yaw_per_sqrt_m * distance;
+  double yaw = q.yaw_per_sqrt_m * q.yaw_per_sqrt_m * distance;
+  if (q.yaw_per_sqrt_rad > 0) yaw += q.yaw_per_sqrt_rad * q.yaw_per_sqrt_rad * std::abs(moved.yaw);
   return {belief.pose.compose(moved),
           belief.covariance + Eigen::Vector3d(position, position, yaw).asDiagonal().toDenseMatrix(), odometry_};
 }

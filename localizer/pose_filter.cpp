@@ -78,8 +78,9 @@ void PoseFilter::start_mount_yaw() {
 void PoseFilter::start_bias(const GpsErrorModel& gps) {
   x_.segment<3>(kBias).setZero();
   P_.block<3, 3>(kBias, kBias) = gps.bias_variance.asDiagonal();
-  P_.block<3, kStates>(kBias, 0).leftCols<3>().setZero();
-  P_.block<kStates, 3>(0, kBias).topRows<3>().setZero();
+  // Independent of everything else, a fresh start.
+  P_.block<3, 3>(kBias, 0).setZero();
+  P_.block<3, 3>(0, kBias).setZero();
   P_.block<1, 3>(kMount, kBias).setZero();
   P_.block<3, 1>(kBias, kMount).setZero();
 }
@@ -119,14 +120,22 @@ void PoseFilter::reset_states(const Eigen::Matrix3d& covariance, const UnplacedA
   MatrixM P = MatrixM::Zero();
   P.template topLeftCorner<3, 3>() = to_frame * covariance * to_frame.transpose();
   if (gps_) P.template block<3, 3>(kBias, kBias) = to_frame * gps_->bias_variance.asDiagonal() * to_frame.transpose();
-  // Each unplaced axis with its bias (along: 0 and 3; heading: 2 and 5), and the mount yaw, which no
-  // search places; the search's covariance says how the axes go together.
-  std::vector<int> kept;
-  if (M > kMount) kept.push_back(kMount);
-  if (unplaced.along) kept.insert(kept.end(), {0, kBias});
-  if (unplaced.heading) kept.insert(kept.end(), {2, kBias + 2});
-  for (int i : kept)
-    for (int j : kept) P(i, j) = old(i, j);
+  // Each unplaced axis keeps its block of the old covariance: along with its bias (0 and 3), the heading
+  // with its bias and the mount yaw (2, 5 and 6), which no search places. A placed heading leaves the
+  // mount yaw its own. The search's covariance says how the axes go together; blocks taken whole from a
+  // covariance, side by side, are one.
+  std::vector<std::vector<int>> kept;
+  if (unplaced.along) kept.push_back({0, kBias});
+  if (unplaced.heading) kept.push_back({2, kBias + 2});
+  if (M > kMount) {
+    if (unplaced.heading)
+      kept.back().push_back(kMount);
+    else
+      kept.push_back({kMount});
+  }
+  for (const std::vector<int>& block : kept)
+    for (int i : block)
+      for (int j : block) P(i, j) = old(i, j);
   P_.topLeftCorner<M, M>() = T.transpose() * P * T;
 }
 

@@ -114,9 +114,10 @@ class PoseFilter {
   // Prediction: the car moves to `predicted` (car_pose() moved by MotionPredictor), having driven
   // `distance` in `dt`.
   void predict(const Pose2d& predicted, double distance, double dt);
-  // KF1: a GPS fix (x, y in the local frame, heading): z = pose + bias + white noise.
+  // KF1: a GPS fix (x, y in the local frame, heading): z = car_pose() + bias + white noise.
   void update_gps(const Eigen::Vector3d& z, const GpsErrorModel& gps);
-  // The fix's innovation (z minus pose and bias, the angle wrapped) and its covariance: for gating.
+  // The fix's innovation (z minus the car's pose and the bias, the angle wrapped) and its covariance: for
+  // gating.
   Eigen::Vector3d gps_innovation(const Eigen::Vector3d& z) const;
   Eigen::Matrix3d gps_innovation_covariance(const GpsErrorModel& gps) const;
   // KF2: the curb matching observation (x_c, y_c, psi_c) and the intensity one (x_s, y_s), both of the

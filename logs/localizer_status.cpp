@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <string_view>
 
@@ -49,11 +50,14 @@ class Values {
     return out;
   }
   bool has(const std::string& key) const { return values_.count(key) != 0; }
-  double finite(const std::string& key) const {
+  // A finite number, at least `min`.
+  double finite(const std::string& key, double min = -std::numeric_limits<double>::infinity()) const {
     const std::string& v = text(key);
     double out = 0;
     const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
-    if (ec != std::errc() || end != v.data() + v.size() || !std::isfinite(out)) fail(key, v, "a finite number");
+    if (ec != std::errc() || end != v.data() + v.size() || !std::isfinite(out) || out < min)
+      fail(key, v,
+           min > -std::numeric_limits<double>::infinity() ? "a finite number, not negative" : "a finite number");
     return out;
   }
   uint32_t flags(const std::string& key) const {
@@ -112,7 +116,7 @@ std::optional<LocalizerStatus> decode_localizer_status(ros2::View cdr, const std
     s.wide_search = v.boolean("wide_search");
     if (v.has("mount_yaw_deg") || v.has("mount_yaw_sigma_deg")) {
       s.mount_yaw_deg = v.finite("mount_yaw_deg");
-      s.mount_yaw_sigma_deg = v.finite("mount_yaw_sigma_deg");
+      s.mount_yaw_sigma_deg = v.finite("mount_yaw_sigma_deg", 0.0);
     }
     return s;
   }

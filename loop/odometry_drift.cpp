@@ -48,7 +48,7 @@ std::vector<OdometryDrift> odometry_drift(const std::vector<TruthSample>& truth,
     double next_start = 0;
     for (size_t start = 0; start < samples.size(); ++start) {
       if (samples[start].distance < next_start) continue;
-      next_start = samples[start].distance + 1.0;  // a stretch every metre driven
+      while (next_start <= samples[start].distance) next_start += 1.0;  // a stretch every metre driven
       end = std::max(end, start);
       while (end < samples.size() && samples[end].distance - samples[start].distance < d.length_m) ++end;
       if (end == samples.size()) break;

@@ -106,16 +106,14 @@ ScoredRun score_and_write(const std::string& dir, const std::string& scenario_na
     if (e.intensity_observation) intensities.push_back(*e.intensity_observation);
   }
   // An axis the curbs do not constrain (a straight's along, sigma of 100 m) says nothing to check: left
-  // out beyond the inlier distance, beyond which the curb matcher takes no information either.
-  if (!poses.empty() || !intensities.empty()) {
-    const double informative_sigma = localizer_params_for(scenario).curb_noise.inlier_distance_m;
-    if (!poses.empty())
-      scored.metrics.pose_observations =
-          observation_consistency(truth, poses, mount.lidar_rpy_rad.z(), informative_sigma);
-    if (!intensities.empty())
-      scored.metrics.intensity_observations =
-          observation_consistency(truth, intensities, mount.lidar_rpy_rad.z(), informative_sigma);
-  }
+  // out beyond the inlier distance, beyond which the curb matcher takes no information either. APS's
+  // axes are all checked: one it said nothing on is infinite already.
+  if (!poses.empty())
+    scored.metrics.pose_observations = observation_consistency(
+        truth, poses, mount.lidar_rpy_rad.z(), localizer_params_for(scenario).curb_noise.inlier_distance_m);
+  if (!intensities.empty())
+    scored.metrics.intensity_observations =
+        observation_consistency(truth, intensities, mount.lidar_rpy_rad.z(), std::numeric_limits<double>::infinity());
 
   prepare_output_dir(dir);
   write_metrics_json(dir + "/metrics.json", scored.metrics);

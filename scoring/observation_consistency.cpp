@@ -19,9 +19,10 @@ ObservationConsistency observation_consistency(const std::vector<PoseStamped>& t
     const Eigen::Vector2d exact = Eigen::Vector2d(t.x, t.y) + z.yaw_coupling * wrap_angle(z.pose.yaw - true_yaw);
     const Eigen::Vector2d off = Eigen::Vector2d(z.pose.x, z.pose.y) - exact;
     const double c = std::cos(z.pose.yaw), s = std::sin(z.pose.yaw);
-    const bool intensity = !std::isfinite(z.covariance(2, 2));
+    // An intensity observation's heading is the prior's, not a measurement: its variance is infinite, so
+    // the axis is skipped below.
     const Eigen::Vector3d error(c * off.x() + s * off.y(), -s * off.x() + c * off.y(),
-                                intensity ? 0.0 : wrap_angle(z.pose.yaw - true_yaw));
+                                wrap_angle(z.pose.yaw - true_yaw));
     for (int axis = 0; axis < 3; ++axis) {
       const double variance = z.covariance(axis, axis);
       if (!std::isfinite(variance) || !(variance > 0)) continue;

@@ -308,8 +308,9 @@ std::string integrity_lines(const Metrics& m, const std::string& label) {
   const std::string who = label.empty() ? "" : label + ": ";
   std::string text = "nees       " + who + consistency_text(m) + "\nintegrity  " + who + integrity_text(m) + "\n";
   for (const EventRecovery& r : m.recovery) text += "recovery   " + who + recovery_text(r) + "\n";
+  // The pose match is the curbs' (gicp: the point cloud's); intensity is APS's position.
   for (const auto& [name, o] :
-       {std::pair{"curbs", &m.pose_observations}, std::pair{"intensity", &m.intensity_observations}}) {
+       {std::pair{"pose match", &m.pose_observations}, std::pair{"intensity", &m.intensity_observations}}) {
     if (!*o) continue;
     const ObservationConsistency& c = **o;
     text +=

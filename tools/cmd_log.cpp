@@ -215,8 +215,9 @@ int run_odometry(const Args& args) {
   }
   std::printf(
       "filter     the process noise it stands for: position %.4f m/sqrt(m) and %.3f m/sqrt(s), heading %.5f "
-      "rad/sqrt(m) (filter: in the localizer's parameters)\n",
-      params.filter.position_per_sqrt_m, params.filter.position_per_sqrt_s, params.filter.yaw_per_sqrt_m);
+      "rad/sqrt(m) and %.4f rad/sqrt(rad) turned (filter: in the localizer's parameters)\n",
+      params.filter.position_per_sqrt_m, params.filter.position_per_sqrt_s, params.filter.yaw_per_sqrt_m,
+      params.filter.yaw_per_sqrt_rad);
   return 0;
 }
 

@@ -29,9 +29,23 @@ endfunction()
 
 # metrics.json without its latency lines, nor the lines of what an estimate file may not carry: the
 # covariance (a TUM file has none: its consistency is null), the protection bounds and `lost` (neither
-# file has them: integrity counts no bounds, recovery no `lost`).
+# file has them: integrity counts no bounds, recovery no `lost`), and the map observations the live
+# localizer took (the whole `map_observations` block: only a live run or a replay has them).
 function(accuracy_lines file result)
-  file(STRINGS ${file} lines)
+  file(STRINGS ${file} all)
+  set(lines "")
+  set(depth 0)
+  foreach(line IN LISTS all)
+    if(depth GREATER 0 OR line MATCHES "\"map_observations\"")
+      string(REGEX MATCHALL "[{]" opens "${line}")
+      string(REGEX MATCHALL "[}]" closes "${line}")
+      list(LENGTH opens o)
+      list(LENGTH closes c)
+      math(EXPR depth "${depth} + ${o} - ${c}")
+      continue()
+    endif()
+    list(APPEND lines "${line}")
+  endforeach()
   list(FILTER lines EXCLUDE REGEX
        "\"(latency_|frames_with_covariance|mean_nees_|beyond_3_sigma_|frames_with_bounds|misleading_|availability|lost_raised_after_s|lost_cleared_after_s)")
   set(${result} "${lines}" PARENT_SCOPE)

@@ -231,8 +231,42 @@ TEST(PoseFilter, TheMountYawIsLearntFromTheDriftItWouldCauseAcrossTheRoad) {
   EXPECT_LT(learnt.mount_sigma_at_20s, 0.03 * deg);
   EXPECT_GT(learnt.mount_sigma_at_20s, 0.001 * deg);  // learnt from 200 matches, not to nothing
   const MountRun nominal = drive_with_turned_lidar(mount, 0);
-  EXPECT_EQ(nominal.mount_yaw_at_20s, 0.0);
   EXPECT_NEAR(nominal.car_heading_error_at_20s, mount, 0.03 * deg);  // the matches' heading, mount and all
+}
+
+// A parked car: GPS fixes say where it heads (white noise of 0.5 deg), the curbs say where the nominal
+// frame heads, 0.3 deg more. The mount yaw is the difference, learnt from the two directly; a fix is then
+// judged against the car's heading, not the map's.
+TEST(PoseFilter, TheMountYawIsWhereTheMapsHeadingDiffersFromTheGpss) {
+  const double deg = M_PI / 180, mount = 0.3 * deg;
+  PoseFilterParams params;
+  params.mount_yaw_sigma_rad = 1 * deg;
+  GpsErrorModel gps;
+  gps.white_variance = Eigen::Vector3d(0.25, 0.25, std::pow(0.5 * deg, 2));
+  gps.bias_variance = Eigen::Vector3d(1e-6, 1e-6, 1e-10);
+  gps.tau_s = Eigen::Vector3d::Constant(60);
+  PoseFilter filter({10, 5, 0.5}, Eigen::Vector3d(1, 1, std::pow(2 * deg, 2)).asDiagonal(), params);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> unit;
+  for (int k = 0; k < 300; ++k) {
+    filter.predict(filter.car_pose(), 0, 0.1);
+    filter.update_gps(Eigen::Vector3d(10, 5, 0.5 + 0.5 * deg * unit(rng)), gps);
+    filter.update_curb({10, 5, 0.5 + mount + 0.02 * deg * unit(rng)},
+                       Eigen::Vector3d(0.01, 0.01, std::pow(0.02 * deg, 2)).asDiagonal());
+  }
+  EXPECT_NEAR(filter.mount_yaw(), mount, 0.05 * deg);  // 300 fixes of 0.5 deg: 0.03 deg of noise
+  EXPECT_NEAR(filter.car_pose().yaw, 0.5, 0.05 * deg);
+  EXPECT_LT(std::sqrt(filter.mount_yaw_variance()), 0.05 * deg);
+  EXPECT_NEAR(filter.gps_innovation({10, 5, 0.5})(2), 0, 0.05 * deg);
+  const double fix_doubt = filter.gps_innovation_covariance(gps)(2, 2) - gps.white_variance(2);
+  EXPECT_GT(fix_doubt, 0);
+  EXPECT_LT(fix_doubt, std::pow(0.05 * deg, 2));  // the car's heading and the bias, both known by now
+  // A search that places the car across the road and its heading keeps the mount yaw and its doubt.
+  const double before = filter.mount_yaw_variance();
+  filter.reset_pose({10, 5, 0.5 + mount}, Eigen::Vector3d(0.01, 0.01, 1e-6).asDiagonal(),
+                    {Eigen::Vector2d::UnitX(), false});
+  EXPECT_DOUBLE_EQ(filter.mount_yaw_variance(), before);
+  EXPECT_NEAR(filter.mount_yaw(), mount, 0.05 * deg);
 }
 
 // The yaw rate's scale error: a quarter turn adds k^2 pi/2 to the heading's variance beyond what the

@@ -39,8 +39,8 @@ TEST(ObservationConsistency, OneSigmaOffGivesOneOnItsAxis) {
 }
 
 TEST(ObservationConsistency, AnIntensityMatchAtAWrongHeadingIsJudgedWithItsCoupling) {
-  // APS matched at a prior heading 1 deg off the truth, on paint 12.5 m ahead: its answer lies
-  // J (psi_prior - psi) from the car, J = (12.5, 0) m/rad to the right of north... exactly, so no error.
+  // APS matched at a prior heading 1 deg off the truth: its answer lies J (psi_prior - psi) from the car,
+  // here J = (12.5, 0) m/rad. An answer exactly there has no error.
   const double off = M_PI / 180;
   MapObservation aps;
   aps.stamp_ns = 1'000'000'000;  // the truth is at (5, 10)

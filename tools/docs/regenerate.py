@@ -348,7 +348,9 @@ def target_integrity(r, commands):
 # The filter's process noise at what CAN drifts, with the mount yaw learnt: (label, what the scenario's
 # `localizer:` section gets beside its method). The noise is `lidarloop odometry`'s on the campus drive:
 # 0.016 m/sqrt(m) along the road over 10 m (the wheels' 0.5 % scale error), 0.0004 rad/sqrt(m) of heading
-# over 50 m, and the same 0.5 % of every angle turned.
+# over 50 m; per angle turned, the same 0.5 % of a 90 deg bend as one sigma of a random walk,
+# 0.005 sqrt(pi / 2) = 0.0063 rad/sqrt(rad); and 0.01 m/sqrt(s) where the default has 0.2: CAN sees every
+# metre, and this is what is left for what it cannot (the time term also lets the GPS's bias through).
 PROCESS_NOISE_SCENARIOS = ["dynamic_campus", "closed_loop_campus"]
 PROCESS_NOISE_SEEDS = "1-10"
 CAN_NOISE = "filter: {position_per_sqrt_m: 0.016, position_per_sqrt_s: 0.01, yaw_per_sqrt_m: 0.0004, yaw_per_sqrt_rad: 0.0063}"
