@@ -359,6 +359,9 @@ PROCESS_NOISE_VARIANTS = [
     ("mount yaw learnt", "mount_uncertainty: {learn_yaw: true}"),
     ("CAN's drift, mount yaw learnt", "mount_uncertainty: {learn_yaw: true}, " + CAN_NOISE),
     ("CAN's drift, nominal mount", CAN_NOISE),
+    # Does APS claim too much, scan by scan? Its covariance widened four times.
+    ("CAN's drift, mount yaw learnt, APS's covariance x4",
+     "aps_covariance_scale: 4, mount_uncertainty: {learn_yaw: true}, " + CAN_NOISE),
 ]
 
 
