@@ -143,7 +143,9 @@ void PoseFilter::predict(const Pose2d& predicted, double distance, double dt) {
   // Jacobian of moving by the odometry increment: a displacement (dx, dy) in the body frame rotates with
   // the car's heading, psi_m - mount yaw.
   const double dpx = predicted.x - x_(0), dpy = predicted.y - x_(1);
-  const double turned = std::abs(wrap_angle(predicted.yaw - car_pose().yaw));
+  const double turned_variance = params_.yaw_per_sqrt_rad > 0 ? params_.yaw_per_sqrt_rad * params_.yaw_per_sqrt_rad *
+                                                                    std::abs(wrap_angle(predicted.yaw - car_pose().yaw))
+                                                              : 0.0;
   Matrix F = Matrix::Identity();
   F(0, 2) = -dpy;
   F(1, 2) = dpx;
@@ -152,8 +154,7 @@ void PoseFilter::predict(const Pose2d& predicted, double distance, double dt) {
   x_.head<3>() = Eigen::Vector3d(predicted.x, predicted.y, wrap_angle(predicted.yaw + x_(kMount)));
   auto sq = [](double v) { return v * v; };
   const double q_pos = sq(params_.position_per_sqrt_m) * distance + sq(params_.position_per_sqrt_s) * dt;
-  double q_yaw = sq(params_.yaw_per_sqrt_m) * distance;
-  if (params_.yaw_per_sqrt_rad > 0) q_yaw += sq(params_.yaw_per_sqrt_rad) * turned;
+  const double q_yaw = sq(params_.yaw_per_sqrt_m) * distance + turned_variance;  // + 0 exactly without it
   Vector q = Vector::Zero();
   q.head<3>() = Eigen::Vector3d(q_pos, q_pos, q_yaw);
   if (gps_) {
